@@ -1,0 +1,36 @@
+"""Specific mechanical cost of transport (Collins et al., Science 2005) and the paper's per-kg variant."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+GRAVITY_MPS2 = 9.81
+
+
+def positive_work(torque, angular_velocity, dt: float) -> np.ndarray:
+    """Per-joint positive mechanical work (J): sum over samples of max(tau * omega, 0) * dt.
+
+    torque, angular_velocity: arrays (n_samples, n_joints) of torques held over each interval and the
+    joint rates over it."""
+    power = np.asarray(torque, dtype=float) * np.asarray(angular_velocity, dtype=float)
+    return np.sum(np.maximum(power, 0.0), axis=0) * dt
+
+
+def cost_of_transport(positive_work_j: float, mass_kg: float, distance_m: float, g: float = GRAVITY_MPS2) -> float:
+    """Dimensionless C_mt = E+ / (m g d). Not finite (inf) unless the distance is positive."""
+    if mass_kg <= 0 or g <= 0:
+        raise ValueError(f"mass_kg and g must be positive, got {mass_kg!r}, {g!r}")
+    if not distance_m > 0:
+        return math.inf
+    return positive_work_j / (mass_kg * g * distance_m)
+
+
+def cost_of_transport_per_kg(positive_work_j: float, mass_kg: float, distance_m: float) -> float:
+    """The paper's printed eq. 1: E+ / (kg * m), in J/(kg*m) (= g times the dimensionless C_mt)."""
+    if mass_kg <= 0:
+        raise ValueError(f"mass_kg must be positive, got {mass_kg!r}")
+    if not distance_m > 0:
+        return math.inf
+    return positive_work_j / (mass_kg * distance_m)

@@ -1,0 +1,51 @@
+"""The central pattern generator (eq. 2-3) and the torque-free gate, as pure functions.
+
+The CPG phase gamma obeys d(gamma)/dt = u_r + kappa * (stance ankle angular velocity) and its output
+zeta = alpha * u_a * sin(gamma) + u_eta is the desired angular velocity of the swing thigh.
+
+Phase resetting (our reading of "the stance and the swing leg are changed by zeta"): gamma is set to 0
+at each confirmed touchdown, and held in [0, pi], so one CPG half-cycle drives one swing. This is the
+standard CPG reading (Nakanishi et al. 2004, Aoi & Tsuchiya 2005) and it ties the phase to the step.
+"""
+
+from __future__ import annotations
+
+import math
+
+from drake_biped.params import CpgParams
+
+
+def phase_rate(cpg: CpgParams, stance_ankle_rate: float) -> float:
+    """d(gamma)/dt in rad/s (eq. 2)."""
+    return cpg.u_r + cpg.kappa * stance_ankle_rate
+
+
+def advance_phase(cpg: CpgParams, gamma: float, stance_ankle_rate: float, dt: float) -> float:
+    """One explicit-Euler step of eq. 2, held in [0, pi] (one half-cycle per step)."""
+    return min(math.pi, max(0.0, gamma + dt * phase_rate(cpg, stance_ankle_rate)))
+
+
+def closed_form_phase(cpg: CpgParams, t: float) -> float:
+    """gamma(t) for kappa = 0 from gamma(0) = 0, before clipping at pi: u_r * t."""
+    return cpg.u_r * t
+
+
+def output(cpg: CpgParams, gamma: float) -> float:
+    """zeta, the desired swing-thigh angular velocity in rad/s (eq. 3, with alpha and u_eta)."""
+    return cpg.alpha * cpg.u_a * math.sin(gamma) + cpg.u_eta
+
+
+def swing_reference(gamma: float, liftoff_angle: float, target_angle: float) -> float:
+    """Desired swing-thigh world angle: the integral of zeta, anchored at lift-off and at the target.
+
+    phi_d = phi_0 + (phi_T - phi_0) * (1 - cos gamma) / 2 runs from the lift-off angle phi_0 at gamma = 0
+    to the target phi_T at gamma = pi; its time derivative is (phi_T - phi_0)/2 * sin(gamma) * d(gamma)/dt,
+    which equals zeta without feedback when phi_T - phi_0 = 2 * alpha * u_a / u_r. Servoing the angle as
+    well as the velocity keeps the swing from drifting (ODE's velocity motor has no such term).
+    """
+    return liftoff_angle + (target_angle - liftoff_angle) * 0.5 * (1.0 - math.cos(gamma))
+
+
+def in_torque_free_window(time_in_step_s: float, start_s: float, end_s: float) -> bool:
+    """True while the hip motor is off: start_s <= time since T_n < end_s, and end_s > start_s."""
+    return end_s > start_s and start_s <= time_in_step_s < end_s

@@ -1,0 +1,110 @@
+"""Wire the plant, the CPG controller, an optional push and the loggers into one Diagram."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import VectorLogSink, LogVectorOutput
+
+from drake_biped.controller import CpgWalkingController
+from drake_biped.kinematics import leg_points
+from drake_biped.model import add_biped
+from drake_biped.params import EpisodeConfig, Push
+
+
+class TorsoPush(LeafSystem):
+    """A horizontal force on the torso's centre of mass during [start, start + duration)."""
+
+    def __init__(self, plant: MultibodyPlant, push: Push):
+        super().__init__()
+        torso = plant.GetBodyByName("torso")
+        self._push = push
+        self._force = ExternallyAppliedSpatialForce()
+        self._force.body_index = torso.index()
+        self._force.p_BoBq_B = torso.default_com()
+        self._on = [self._force]
+        self.DeclareAbstractOutputPort(
+            "spatial_forces",
+            lambda: AbstractValue.Make([ExternallyAppliedSpatialForce()]),
+            self._calc,
+        )
+
+    def force_at(self, t: float) -> float:
+        p = self._push
+        return p.force_n if p.start_s <= t < p.start_s + p.duration_s else 0.0
+
+    def _calc(self, context, output) -> None:
+        self._force.F_Bq_W = SpatialForce(np.zeros(3), np.array([self.force_at(context.get_time()), 0.0, 0.0]))
+        output.set_value([self._force])
+
+
+@dataclass
+class BipedDiagram:
+    diagram: Diagram
+    plant: MultibodyPlant
+    controller: CpgWalkingController
+    state_log: VectorLogSink
+    controller_log: VectorLogSink
+    actuation_log: VectorLogSink
+
+
+def initial_state(config: EpisodeConfig) -> tuple[np.ndarray, np.ndarray, bool, float]:
+    """The paper's initiation: q, v, whether the right leg is the first stance leg, the swing lift-off angle.
+
+    The initial hip angle is the angle between the thighs (the inter-leg angle of the Poincare section):
+    torso upright, right thigh at +hip_angle/2 (front, stance), left at -hip_angle/2 (rear, swing), knees
+    straight, feet parallel to the ground, lowest contact point 0.1 mm above it; every body moves forward
+    at the initial speed (a horizontal velocity of the floating base with zero joint rates)."""
+    a = 0.5 * config.initial.hip_angle_rad
+    slope0 = config.ground.slope_at(0.0)
+    q = np.zeros(9)
+    q[3], q[6] = -a, a
+    q[5], q[8] = slope0 + a, slope0 - a  # foot angle = thigh - knee + ankle = local slope
+    lowest = math.inf
+    for i in (3, 6):
+        p = leg_points(0.0, 0.0, 0.0, q[i], q[i + 1], q[i + 2])
+        for px, pz in ((p.heel_x, p.heel_z), (p.toe_x, p.toe_z)):
+            lowest = min(lowest, pz - config.ground.height(px))
+    q[1] = -lowest + 1e-4
+    v = np.zeros(9)
+    v[0] = config.initial.speed_mps
+    return q, v, True, -a
+
+
+def build_diagram(config: EpisodeConfig, meshcat=None, log_period_s: float | None = None) -> BipedDiagram:
+    """Plant + SceneGraph + controller (+ push) + loggers, as a named Diagram.
+
+    log_period_s: sampling period of the state/actuation/controller logs (default: the control period).
+    """
+    builder = DiagramBuilder()
+    handles = add_biped(builder, config.ground, config.sim.time_step_s)
+    plant = handles.plant
+    _, _, stance_right, liftoff = initial_state(config)
+    controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, stance_right, liftoff))
+    builder.Connect(plant.get_state_output_port(), controller.get_input_port(0))
+    builder.Connect(controller.GetOutputPort("actuation"), plant.get_actuation_input_port())
+    if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:
+        push = builder.AddNamedSystem("torso_push", TorsoPush(plant, config.push))
+        builder.Connect(push.get_output_port(), plant.get_applied_spatial_force_input_port())
+    period = log_period_s or config.sim.control_period_s
+    state_log = LogVectorOutput(plant.get_state_output_port(), builder, period)
+    state_log.set_name("state_log")
+    controller_log = LogVectorOutput(controller.GetOutputPort("controller_state"), builder, period)
+    controller_log.set_name("controller_log")
+    actuation_log = LogVectorOutput(controller.GetOutputPort("actuation"), builder, period)
+    actuation_log.set_name("actuation_log")
+    if meshcat is not None:
+        from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role
+
+        MeshcatVisualizer.AddToBuilder(
+            builder, handles.scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration)
+        )
+    diagram = builder.Build()
+    diagram.set_name("drake_biped")
+    return BipedDiagram(diagram, plant, controller, state_log, controller_log, actuation_log)

@@ -1,0 +1,64 @@
+"""Leg-role logic: hip servo, torso balance, knees, ankles and touchdown, as pure functions.
+
+These are the laws the controller applies once per control period; each is small enough to test alone.
+"""
+
+from __future__ import annotations
+
+from drake_biped.params import GaitParams
+
+
+def clip(value: float, limit: float) -> float:
+    return limit if value > limit else (-limit if value < -limit else value)
+
+
+def hip_servo_torque(
+    gait: GaitParams, angle_error: float, rate_error: float, integral: float
+) -> float:
+    """Swing-hip PID on the swing thigh's world angle (before the torque limit)."""
+    return gait.hip_kp * angle_error + gait.hip_kd * rate_error + gait.hip_ki * integral
+
+
+def torso_torque(gait: GaitParams, pitch: float, pitch_rate: float) -> float:
+    """Stance-hip torque that holds the torso at gait.torso_pitch_rad.
+
+    A positive hip torque turns the torso clockwise (forward), so a torso leaning back (pitch above the
+    reference) asks for a positive torque."""
+    return gait.torso_kp * (pitch - gait.torso_pitch_rad) + gait.torso_kd * pitch_rate
+
+
+def placement_target(gait: GaitParams, amplitude: float, hip_ahead_of_stance_m: float, hip_speed: float) -> float:
+    """End-of-swing thigh angle: the CPG amplitude plus Raibert-style foot-placement feedback."""
+    return amplitude + gait.placement_gain * hip_ahead_of_stance_m + gait.placement_velocity_gain * hip_speed
+
+
+def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float) -> float:
+    """Bang-bang swing knee: flex early in the swing (until the knee reaches its flexion limit), then
+    extend once the CPG phase passes knee_extend_phase."""
+    if gamma < gait.knee_extend_phase and knee_angle < gait.knee_flex_max_rad:
+        return gait.knee_flex_torque
+    return -gait.knee_extend_torque
+
+
+def ankle_torque(gait: GaitParams, foot_angle: float, foot_rate: float, ground_angle: float) -> float:
+    """PD that keeps the foot parallel to the local ground."""
+    return -gait.ankle_kp * (foot_angle - ground_angle) - gait.ankle_kd * foot_rate
+
+
+def is_touchdown(
+    gait: GaitParams,
+    time_in_step_s: float,
+    swing_clearance_m: float,
+    swing_ankle_advance_m: float,
+    gamma: float,
+) -> bool:
+    """A confirmed touchdown of the swing foot: all four conditions hold.
+
+    Accepting a touchdown too early (a scuff in mid-swing) swaps the legs with the swing foot behind:
+    the minimum step time, the forward advance and the phase threshold rule that out."""
+    return (
+        time_in_step_s > gait.touchdown_min_step_s
+        and swing_clearance_m < gait.touchdown_height_m
+        and swing_ankle_advance_m > gait.touchdown_min_advance_m
+        and gamma > gait.touchdown_min_phase
+    )

@@ -1,0 +1,79 @@
+"""Planar forward kinematics of the biped, in plain Python for the controller's hot path.
+
+Sign conventions (see models/biped.urdf): x forward, z up, every angle counter-clockwise in the x-z view.
+The torso pitch is positive when leaning back; a thigh's world angle is pitch + hip and is positive when
+the foot is ahead of the hip; the shank's is thigh - knee; the foot's is shank + ankle.
+`tests/test_kinematics.py` checks these functions against MultibodyPlant.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+from drake_biped.params import (
+    CONTACT_RADIUS_M,
+    HEEL_X_M,
+    SOLE_DEPTH_M,
+    TABLE_I_LENGTHS_M,
+    TABLE_I_MASSES_KG,
+    TOE_X_M,
+    TOTAL_MASS_KG,
+)
+
+THIGH_M = TABLE_I_LENGTHS_M["thigh"]
+SHANK_M = TABLE_I_LENGTHS_M["shank"]
+TORSO_M = TABLE_I_LENGTHS_M["torso"]
+# Contact spheres: centre one radius above the sole, at the heel and at the toe.
+_SPHERE_Z = -SOLE_DEPTH_M + CONTACT_RADIUS_M
+_FOOT_COM = (0.03, -0.015)  # foot centre of mass in the ankle frame (m)
+
+
+class LegPoints(NamedTuple):
+    """World (x, z) of a leg's knee, ankle, and heel/toe contact points (lowest point of each sphere)."""
+
+    knee_x: float
+    knee_z: float
+    ankle_x: float
+    ankle_z: float
+    heel_x: float
+    heel_z: float
+    toe_x: float
+    toe_z: float
+    thigh_angle: float
+    shank_angle: float
+    foot_angle: float
+
+
+def leg_points(x: float, z: float, pitch: float, hip: float, knee: float, ankle: float) -> LegPoints:
+    """Points of one leg for hip position (x, z), torso pitch and the leg's joint angles (rad)."""
+    thigh = pitch + hip
+    shank = thigh - knee
+    foot = shank + ankle
+    kx = x + THIGH_M * math.sin(thigh)
+    kz = z - THIGH_M * math.cos(thigh)
+    ax = kx + SHANK_M * math.sin(shank)
+    az = kz - SHANK_M * math.cos(shank)
+    c, s = math.cos(foot), math.sin(foot)
+    # Foot frame axes in the world: ex = (c, s), ez = (-s, c). Sphere bottoms are one radius below.
+    hx = ax + HEEL_X_M * c - _SPHERE_Z * s
+    hz = az + HEEL_X_M * s + _SPHERE_Z * c - CONTACT_RADIUS_M
+    tx = ax + TOE_X_M * c - _SPHERE_Z * s
+    tz = az + TOE_X_M * s + _SPHERE_Z * c - CONTACT_RADIUS_M
+    return LegPoints(kx, kz, ax, az, hx, hz, tx, tz, thigh, shank, foot)
+
+
+def center_of_mass(q) -> tuple[float, float]:
+    """Whole-body centre of mass (x, z) for q = (x, z, pitch, hipL, kneeL, ankleL, hipR, kneeR, ankleR)."""
+    x, z, pitch = q[0], q[1], q[2]
+    mt, mth, msh, mft = (TABLE_I_MASSES_KG[k] for k in ("torso", "thigh", "shank", "foot"))
+    sx = mt * (x - 0.5 * TORSO_M * math.sin(pitch))
+    sz = mt * (z + 0.5 * TORSO_M * math.cos(pitch))
+    for i in (3, 6):
+        p = leg_points(x, z, pitch, q[i], q[i + 1], q[i + 2])
+        sx += mth * 0.5 * (x + p.knee_x) + msh * 0.5 * (p.knee_x + p.ankle_x)
+        sz += mth * 0.5 * (z + p.knee_z) + msh * 0.5 * (p.knee_z + p.ankle_z)
+        c, s = math.cos(p.foot_angle), math.sin(p.foot_angle)
+        sx += mft * (p.ankle_x + _FOOT_COM[0] * c - _FOOT_COM[1] * s)
+        sz += mft * (p.ankle_z + _FOOT_COM[0] * s + _FOOT_COM[1] * c)
+    return sx / TOTAL_MASS_KG, sz / TOTAL_MASS_KG

@@ -1,0 +1,147 @@
+"""Build the biped MultibodyPlant from `models/biped.urdf` and add the ground.
+
+The robot is loaded by `package://drake_biped/biped.urdf` through `models/package.xml`, never by a path
+relative to the caller's working directory.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pydrake.geometry import Box, HalfSpace, ProximityProperties
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import (
+    AddMultibodyPlant,
+    CoulombFriction,
+    MultibodyPlant,
+    MultibodyPlantConfig,
+)
+from pydrake.geometry import AddContactMaterial, SceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_biped.params import Ground
+
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+PACKAGE_XML = MODELS_DIR / "package.xml"
+MODEL_URL = "package://drake_biped/biped.urdf"
+
+# Joint order used everywhere in the toolkit (positions 3..8, velocities 3..8, actuators 0..5).
+JOINT_NAMES = (
+    "left_hip",
+    "left_knee",
+    "left_ankle",
+    "right_hip",
+    "right_knee",
+    "right_ankle",
+)
+BASE_NAMES = ("x", "z", "pitch")
+FOOT_BODIES = ("left_foot", "right_foot")
+
+
+class ModelError(RuntimeError):
+    """The model file is missing, malformed, or not the biped this toolkit expects."""
+
+
+@dataclass(frozen=True)
+class PlantHandles:
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+
+
+def add_biped(
+    builder: DiagramBuilder,
+    ground: Ground,
+    time_step_s: float,
+    model_url: str = MODEL_URL,
+    package_xml: Path = PACKAGE_XML,
+) -> PlantHandles:
+    """Add the biped and the ground to `builder` and finalize the plant.
+
+    Contact: SAP with point contact (the heel/toe spheres against the ground half-space(s)).
+    """
+    config = MultibodyPlantConfig(
+        time_step=time_step_s,
+        discrete_contact_approximation="sap",
+        contact_model="point",
+        penetration_allowance=1e-3,
+    )
+    plant, scene_graph = AddMultibodyPlant(config, builder)
+    parser = Parser(plant)
+    if not package_xml.is_file():
+        raise ModelError(f"model package file not found: {package_xml}")
+    parser.package_map().AddPackageXml(str(package_xml))
+    try:
+        parser.AddModels(url=model_url)
+    except Exception as exc:  # Drake raises RuntimeError with the parser's message
+        raise ModelError(f"could not parse the biped model {model_url}: {exc}") from exc
+    _add_ground(plant, ground)
+    plant.Finalize()
+    check_layout(plant)
+    return PlantHandles(plant, scene_graph)
+
+
+def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
+    """Ground as half-space(s) for contact plus thin boxes so Meshcat can draw it."""
+    friction = CoulombFriction(ground.friction, ground.friction)
+    world = plant.world_body()
+
+    def add_plane(name: str, angle: float, through_x: float) -> None:
+        # Half-space whose surface passes through (through_x, 0, 0), tilted by `angle` (ascending +x).
+        rotation = RotationMatrix.MakeYRotation(-angle)
+        X = RigidTransform(rotation, [through_x, 0.0, 0.0])
+        props = ProximityProperties()
+        AddContactMaterial(friction=friction, properties=props)
+        plant.RegisterCollisionGeometry(world, X, HalfSpace(), name, props)
+
+    def add_visual(name: str, angle: float, x0: float, x1: float, z0: float) -> None:
+        length = (x1 - x0) / math.cos(angle)
+        centre_x = 0.5 * (x0 + x1)
+        centre_z = z0 + 0.5 * (x1 - x0) * math.tan(angle)
+        rotation = RotationMatrix.MakeYRotation(-angle)
+        offset = rotation.multiply(np.array([0.0, 0.0, -0.01]))
+        X = RigidTransform(rotation, [centre_x + offset[0], 0.0, centre_z + offset[2]])
+        plant.RegisterVisualGeometry(world, X, Box(length, 1.0, 0.02), name, np.array([0.45, 0.6, 0.45, 1.0]))
+
+    if ground.level_length_m is None:
+        add_plane("ground", ground.slope_rad, 0.0)
+        add_visual("ground_visual", ground.slope_rad, -5.0, 60.0, -5.0 * math.tan(ground.slope_rad))
+    else:
+        # Level-then-ascending: the union of two half-spaces is exactly max(0, (x - x0) tan s).
+        add_plane("ground_level", 0.0, 0.0)
+        add_plane("ground_slope", ground.slope_rad, ground.level_length_m)
+        add_visual("ground_level_visual", 0.0, -5.0, ground.level_length_m, 0.0)
+        add_visual("ground_slope_visual", ground.slope_rad, ground.level_length_m, 60.0, 0.0)
+
+
+def check_layout(plant: MultibodyPlant) -> None:
+    """Raise ModelError unless positions, velocities and actuators follow JOINT_NAMES' order."""
+    if plant.num_positions() != 9 or plant.num_velocities() != 9 or plant.num_actuators() != 6:
+        raise ModelError(
+            f"expected 9 positions, 9 velocities and 6 actuators, got {plant.num_positions()}, "
+            f"{plant.num_velocities()}, {plant.num_actuators()}"
+        )
+    base = plant.GetJointByName("floating_base")
+    if base.type_name() != "planar" or base.position_start() != 0:
+        raise ModelError("the floating base must be the planar joint at position 0")
+    for i, name in enumerate(JOINT_NAMES):
+        joint = plant.GetJointByName(name)
+        if joint.position_start() != 3 + i or joint.velocity_start() != 3 + i:
+            raise ModelError(f"joint {name} is at position {joint.position_start()}, expected {3 + i}")
+        actuator = plant.GetJointActuatorByName(f"{name}_motor")
+        if int(actuator.index()) != i:
+            raise ModelError(f"actuator {name}_motor has index {int(actuator.index())}, expected {i}")
+
+
+def effort_limits(plant: MultibodyPlant) -> np.ndarray:
+    """Actuator torque limits (N*m) in JOINT_NAMES order, as read from the model file."""
+    return np.array([plant.GetJointActuatorByName(f"{n}_motor").effort_limit() for n in JOINT_NAMES])
+
+
+def build_plant(ground: Ground | None = None, time_step_s: float = 1e-3) -> MultibodyPlant:
+    """A finalized plant in its own diagram builder, for inspection and tests."""
+    builder = DiagramBuilder()
+    return add_biped(builder, ground or Ground(), time_step_s).plant

@@ -1,0 +1,314 @@
+"""Parameters of the robot, the CPG controller and an episode, as validated frozen dataclasses.
+
+Everything a simulation depends on lives here, so a result record can hold the exact inputs that made it.
+SI units throughout; angles in radians (degrees appear only at the command-line edge).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+# Table I of the paper: link lengths (m) and masses (kg).
+TABLE_I_LENGTHS_M = {"torso": 0.312, "thigh": 0.280, "shank": 0.317, "foot": 0.180}
+TABLE_I_MASSES_KG = {"torso": 6.646, "thigh": 0.673, "shank": 0.707, "foot": 0.398}
+TOTAL_MASS_KG = TABLE_I_MASSES_KG["torso"] + 2 * sum(
+    TABLE_I_MASSES_KG[k] for k in ("thigh", "shank", "foot")
+)
+HIP_LIMIT_RAD = math.radians(51.0)
+ANKLE_LIMIT_RAD = math.radians(26.0)
+KNEE_LIMIT_RAD = (0.0, 2.4)  # 0 is full extension: the knee cannot hyper-extend.
+# Documented motor torque limits (N*m); the paper does not print them.
+EFFORT_LIMITS_NM = {"hip": 40.0, "knee": 30.0, "ankle": 20.0}
+# Foot geometry (m), in the ankle frame: heel and toe contact points, sole depth below the ankle.
+HEEL_X_M = -0.06
+TOE_X_M = 0.12
+SOLE_DEPTH_M = 0.03
+CONTACT_RADIUS_M = 0.01
+GRAVITY_MPS2 = 9.81
+
+
+class ParameterError(ValueError):
+    """A parameter is unknown, non-finite or out of its range. The message names it."""
+
+
+def _check_finite(owner: str, name: str, value: float) -> None:
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
+        raise ParameterError(f"{owner}.{name} must be a finite number, got {value!r}")
+
+
+def _check_range(owner: str, name: str, value: float, lo: float | None, hi: float | None) -> None:
+    _check_finite(owner, name, value)
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        lo_s = "-inf" if lo is None else f"{lo:g}"
+        hi_s = "inf" if hi is None else f"{hi:g}"
+        raise ParameterError(f"{owner}.{name} = {value!r} is outside [{lo_s}, {hi_s}]")
+
+
+class _Validated:
+    """Mixin: every float field is checked against `_RANGES` (name -> (lo, hi)) after init."""
+
+    _RANGES: dict[str, tuple[float | None, float | None]] = {}
+
+    def __post_init__(self) -> None:
+        owner = type(self).__name__
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name in self._RANGES:
+                _check_range(owner, f.name, value, *self._RANGES[f.name])
+            elif isinstance(value, float):
+                _check_finite(owner, f.name, value)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any] | None):
+        data = dict(data or {})
+        known = {f.name: f for f in fields(cls)}
+        unknown = sorted(set(data) - set(known))
+        if unknown:
+            raise ParameterError(f"{cls.__name__}: unknown parameter(s) {unknown}; known: {sorted(known)}")
+        kwargs = {}
+        for name, value in data.items():
+            sub = _NESTED.get((cls.__name__, name))
+            if sub is not None:
+                kwargs[name] = None if value is None else sub.from_dict(value)
+            elif isinstance(value, int) and not isinstance(value, bool) and known[name].type == "float":
+                kwargs[name] = float(value)
+            else:
+                kwargs[name] = value
+        return cls(**kwargs)
+
+
+@dataclass(frozen=True)
+class CpgParams(_Validated):
+    """The CPG of eq. 2-3 with Table III's symbols.
+
+    Phase: d(gamma)/dt = u_r + kappa * (stance ankle angular velocity).
+    Output (desired swing-hip angular velocity, rad/s): zeta = alpha * u_a * sin(gamma) + u_eta.
+    The paper prints alpha and u_eta in Table III but not in eq. 3; this affine form contains both and
+    reduces to eq. 3 for the paper's alpha = 1, u_eta = 0.
+    """
+
+    alpha: float = 1.0
+    u_a: float = 2.0
+    u_eta: float = 0.0
+    u_r: float = 2.1
+    kappa: float = 1.8
+
+    # Table IV's grid-search ranges bound what the toolkit accepts, widened for u_a and u_r.
+    _RANGES = {
+        "alpha": (-2.0, 2.0),
+        "u_a": (0.0, 20.0),
+        "u_eta": (-1.0, 1.0),
+        "u_r": (1e-3, 30.0),
+        "kappa": (-10.0, 10.0),
+    }
+
+    @property
+    def swing_amplitude_rad(self) -> float:
+        """Half the thigh excursion of one CPG half-cycle without feedback: alpha * u_a / u_r."""
+        return self.alpha * self.u_a / self.u_r
+
+
+PAPER_CPG = CpgParams()  # Table III as printed.
+
+
+@dataclass(frozen=True)
+class GaitParams(_Validated):
+    """Gains and thresholds of the hip servo, torso balance, knees, ankles and touchdown detection."""
+
+    # Swing hip: PID servo of the swing thigh's world angle to the CPG reference (angle, zeta).
+    hip_kp: float = 90.0  # N*m/rad
+    hip_kd: float = 11.0  # N*m*s/rad
+    hip_ki: float = 0.0  # N*m/(rad*s)
+    # Foot placement: end-of-swing thigh angle = A + placement_gain * (hip x - stance ankle x)
+    #                 + placement_velocity_gain * (hip x velocity).
+    placement_gain: float = 0.55  # rad/m
+    placement_velocity_gain: float = 0.1  # rad*s/m
+    # Torso: stance-hip PD to a constant pitch (negative = forward lean), minus the swing-hip torque.
+    torso_kp: float = 280.0  # N*m/rad
+    torso_kd: float = 28.0  # N*m*s/rad
+    torso_pitch_rad: float = -0.06
+    # Swing knee, bang-bang: flex until the CPG phase passes knee_extend_phase (or the knee reaches
+    # knee_flex_max_rad), then extend until touchdown. Stance knee: constant extending torque.
+    knee_flex_torque: float = 4.4  # N*m
+    knee_extend_torque: float = 9.3  # N*m
+    knee_extend_phase: float = 1.64  # rad of CPG phase
+    knee_flex_max_rad: float = 0.48
+    stance_knee_torque: float = 17.7  # N*m
+    # Ankles: PD keeping each foot parallel to the local ground.
+    ankle_kp: float = 20.0  # N*m/rad
+    ankle_kd: float = 0.3  # N*m*s/rad
+    # Touchdown (stance/swing swap) is accepted only when all hold.
+    touchdown_min_step_s: float = 0.15
+    touchdown_height_m: float = 0.002
+    touchdown_min_advance_m: float = 0.05
+    touchdown_min_phase: float = 1.0  # rad of CPG phase
+
+    _RANGES = {
+        "hip_kp": (0.0, 2000.0),
+        "hip_kd": (0.0, 200.0),
+        "hip_ki": (0.0, 2000.0),
+        "placement_gain": (-5.0, 5.0),
+        "placement_velocity_gain": (-5.0, 5.0),
+        "torso_kp": (0.0, 5000.0),
+        "torso_kd": (0.0, 500.0),
+        "torso_pitch_rad": (-0.5, 0.5),
+        "knee_flex_torque": (0.0, 30.0),
+        "knee_extend_torque": (0.0, 30.0),
+        "knee_extend_phase": (0.0, math.pi),
+        "knee_flex_max_rad": (0.0, 2.4),
+        "stance_knee_torque": (0.0, 30.0),
+        "ankle_kp": (0.0, 500.0),
+        "ankle_kd": (0.0, 50.0),
+        "touchdown_min_step_s": (0.0, 5.0),
+        "touchdown_height_m": (0.0, 0.05),
+        "touchdown_min_advance_m": (-0.5, 0.5),
+        "touchdown_min_phase": (0.0, math.pi),
+    }
+
+
+@dataclass(frozen=True)
+class InitialConditions(_Validated):
+    """The paper's initiation: the thighs spread by hip_angle_rad (split evenly about an upright torso),
+    all bodies moving forward at speed_mps. Both feet start on the ground; the front leg is the first
+    stance leg. (Read as each thigh at +-7.6 deg, the body could not vault over the front foot at
+    0.175 m/s: an inverted pendulum of 0.6 m needs 0.33 m/s for that; as the angle between the
+    thighs it needs 0.166 m/s.)"""
+
+    hip_angle_rad: float = math.radians(7.6)
+    speed_mps: float = 0.175
+
+    _RANGES = {"hip_angle_rad": (0.0, 0.9), "speed_mps": (-2.0, 3.0)}
+
+
+@dataclass(frozen=True)
+class TorqueFreeWindow(_Validated):
+    """Swing-hip torque is exactly zero from start_s to end_s after each step start T_n.
+
+    end_s <= start_s means no window (the paper's convention t2 <= t1)."""
+
+    start_s: float = 0.0
+    end_s: float = 0.0
+
+    _RANGES = {"start_s": (0.0, 10.0), "end_s": (0.0, 10.0)}
+
+    @property
+    def active(self) -> bool:
+        return self.end_s > self.start_s
+
+
+@dataclass(frozen=True)
+class Push(_Validated):
+    """A horizontal force on the torso (N, + forward) from start_s for duration_s."""
+
+    force_n: float = 0.0
+    start_s: float = 0.4
+    duration_s: float = 0.1
+
+    _RANGES = {"force_n": (-1000.0, 1000.0), "start_s": (0.0, None), "duration_s": (0.0, 10.0)}
+
+
+@dataclass(frozen=True)
+class Ground(_Validated):
+    """Ground: level (slope 0), tilted everywhere, or level up to level_length_m then tilted.
+
+    slope_rad > 0 ascends in +x. A piecewise ground (level_length_m set) must ascend."""
+
+    slope_rad: float = 0.0
+    level_length_m: float | None = None
+    friction: float = 1.0
+
+    _RANGES = {"slope_rad": (-0.3, 0.3), "friction": (0.05, 5.0)}
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.level_length_m is not None:
+            _check_range("Ground", "level_length_m", self.level_length_m, 0.0, 1000.0)
+            if self.slope_rad < 0:
+                raise ParameterError(
+                    f"Ground.slope_rad = {self.slope_rad!r}: a level-then-slope ground must ascend (>= 0)"
+                )
+
+    def height(self, x: float) -> float:
+        """Ground height (m) at horizontal position x (m)."""
+        if self.level_length_m is None:
+            return x * math.tan(self.slope_rad)
+        return max(0.0, (x - self.level_length_m) * math.tan(self.slope_rad))
+
+    def slope_at(self, x: float) -> float:
+        """Local ground angle (rad) at x."""
+        if self.level_length_m is None or x >= self.level_length_m:
+            return self.slope_rad
+        return 0.0
+
+
+@dataclass(frozen=True)
+class SimulationParams(_Validated):
+    """Plant time step, controller rate and episode limits."""
+
+    time_step_s: float = 1e-3
+    control_period_s: float = 1e-3
+    distance_m: float = 10.0
+    max_time_s: float = 60.0
+    # Fall: hip below this height above the ground, or torso pitch beyond this angle.
+    fall_hip_height_m: float = 0.35
+    fall_pitch_rad: float = 1.0
+
+    _RANGES = {
+        "time_step_s": (1e-5, 0.02),
+        "control_period_s": (1e-5, 0.05),
+        "distance_m": (1e-3, 1e4),
+        "max_time_s": (1e-3, 1e5),
+        "fall_hip_height_m": (0.0, 0.6),
+        "fall_pitch_rad": (0.05, math.pi),
+    }
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        ratio = self.control_period_s / self.time_step_s
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise ParameterError(
+                f"SimulationParams.control_period_s = {self.control_period_s!r} must be a whole multiple "
+                f"of time_step_s = {self.time_step_s!r}"
+            )
+
+
+@dataclass(frozen=True)
+class EpisodeConfig(_Validated):
+    """Everything one episode depends on."""
+
+    cpg: CpgParams = field(default_factory=lambda: DEFAULT_CPG)
+    gait: GaitParams = field(default_factory=lambda: DEFAULT_GAIT)
+    initial: InitialConditions = field(default_factory=InitialConditions)
+    window: TorqueFreeWindow = field(default_factory=TorqueFreeWindow)
+    ground: Ground = field(default_factory=Ground)
+    push: Push | None = None
+    sim: SimulationParams = field(default_factory=SimulationParams)
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0:
+            raise ParameterError(f"EpisodeConfig.seed must be a non-negative integer, got {self.seed!r}")
+
+    def replace(self, **changes: Any) -> EpisodeConfig:
+        return dataclasses.replace(self, **changes)
+
+
+_NESTED = {
+    ("EpisodeConfig", "cpg"): CpgParams,
+    ("EpisodeConfig", "gait"): GaitParams,
+    ("EpisodeConfig", "initial"): InitialConditions,
+    ("EpisodeConfig", "window"): TorqueFreeWindow,
+    ("EpisodeConfig", "ground"): Ground,
+    ("EpisodeConfig", "push"): Push,
+    ("EpisodeConfig", "sim"): SimulationParams,
+}
+
+# The gait this toolkit walks by default (see README, "Model and controller choices").
+DEFAULT_CPG = CpgParams(alpha=1.0, u_a=3.26, u_eta=0.0, u_r=8.59, kappa=1.69)
+DEFAULT_GAIT = GaitParams()
