@@ -6,11 +6,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
-from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import VectorLogSink, LogVectorOutput
+from pydrake.systems.primitives import LogVectorOutput, VectorLogSink
 
 from drake_biped.controller import CpgWalkingController
 from drake_biped.kinematics import leg_points

@@ -5,9 +5,10 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
@@ -247,6 +248,7 @@ def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
         "torque_free": ctrl.data()[ctl.GATE].copy(),
         "stance_right": ctrl.data()[ctl.STANCE_RIGHT].copy(),
         "step_start": ctrl.data()[ctl.STEP_START].copy(),
+        "positive_work": ctrl.data()[ctl.POSITIVE_WORK : ctl.POSITIVE_WORK + 6].T.copy(),
         "position_names": np.array(["x", "z", "pitch", *JOINT_NAMES]),
         "actuator_names": np.array([f"{n}_motor" for n in JOINT_NAMES]),
     }

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Box, HalfSpace, ProximityProperties
+from pydrake.geometry import AddContactMaterial, Box, HalfSpace, ProximityProperties, SceneGraph
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import (
@@ -20,7 +20,6 @@ from pydrake.multibody.plant import (
     MultibodyPlant,
     MultibodyPlantConfig,
 )
-from pydrake.geometry import AddContactMaterial, SceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_biped.params import Ground

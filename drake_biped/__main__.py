@@ -1,0 +1,5 @@
+import sys
+
+from drake_biped.cli import main
+
+sys.exit(main())

@@ -1,0 +1,223 @@
+"""Command-line interface: `drake-biped walk`, `drake-biped window-map`.
+
+Every numeric option is validated here, at the boundary, with a message that names the option and value.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from drake_biped.params import (
+    EpisodeConfig,
+    Ground,
+    ParameterError,
+    Push,
+    SimulationParams,
+    TorqueFreeWindow,
+)
+
+
+def _number(kind: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+        if kind == "positive" and value <= 0:
+            raise argparse.ArgumentTypeError(f"{text!r} must be > 0")
+        if kind == "nonnegative" and value < 0:
+            raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
+        return value
+
+    parse.__name__ = f"{kind} number"
+    return parse
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
+    return value
+
+
+def _add_episode_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--params", type=Path, help="JSON file with EpisodeConfig fields (cpg, gait, initial, ...)")
+    p.add_argument("--distance", type=_number("positive"), help="walk this far (m); default 10")
+    p.add_argument("--max-time", type=_number("positive"), help="simulated time limit (s); default 60")
+    p.add_argument("--time-step", type=_number("positive"), help="plant and control time step (s); default 0.001")
+    p.add_argument("--slope", type=_number("finite"), help="ground slope (rad, > 0 ascends)")
+    p.add_argument("--level-length", type=_number("nonnegative"),
+                   help="level ground for this many metres, then the slope")
+    p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default 0)")
+
+
+def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
+    config = EpisodeConfig()
+    if args.params is not None:
+        if not args.params.is_file():
+            raise ParameterError(f"--params: no such file: {args.params}")
+        try:
+            data = json.loads(args.params.read_text())
+        except json.JSONDecodeError as exc:
+            raise ParameterError(f"--params {args.params}: not valid JSON ({exc})") from None
+        if isinstance(data, dict) and "config" in data:  # a result.json: reuse the config that made it
+            data = data["config"]
+        config = EpisodeConfig.from_dict(data)
+    sim = config.sim
+    if args.distance is not None or args.max_time is not None or args.time_step is not None:
+        sim_d = sim.to_dict()
+        if args.distance is not None:
+            sim_d["distance_m"] = args.distance
+            if args.max_time is None:
+                sim_d["max_time_s"] = max(sim.max_time_s, 6.0 * args.distance)
+        if args.max_time is not None:
+            sim_d["max_time_s"] = args.max_time
+        if args.time_step is not None:
+            sim_d["time_step_s"] = args.time_step
+            sim_d["control_period_s"] = args.time_step
+        sim = SimulationParams(**sim_d)
+    ground = config.ground
+    if args.slope is not None or args.level_length is not None:
+        ground = Ground(
+            slope_rad=args.slope if args.slope is not None else ground.slope_rad,
+            level_length_m=args.level_length if args.level_length is not None else ground.level_length_m,
+            friction=ground.friction,
+        )
+    seed = args.seed if args.seed is not None else config.seed
+    return config.replace(sim=sim, ground=ground, seed=seed)
+
+
+def _progress_bar(total_m: float, desc: str):
+    from tqdm import tqdm
+
+    bar = tqdm(total=round(total_m, 2), desc=desc, unit="m", bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} m [{elapsed}<{remaining}{postfix}]")
+
+    def update(t: float, d: float) -> None:
+        d = min(max(d, 0.0), total_m)
+        bar.n = round(d, 2)
+        bar.set_postfix_str(f"t={t:.1f}s", refresh=False)
+        bar.refresh()
+
+    return bar, update
+
+
+def cmd_walk(args: argparse.Namespace) -> int:
+    from analysis.figures import walk_animation, walk_figure
+    from drake_biped.diagram import build_diagram
+    from drake_biped.episode import run_episode
+    from drake_biped.outputs import (
+        GraphvizMissingError,
+        export_diagram,
+        start_meshcat,
+        warn,
+        write_meshcat_html,
+    )
+
+    config = _episode_config(args)
+    if (args.t1 is None) != (args.t2 is None):
+        raise ParameterError("--t1 and --t2 go together: give both or neither")
+    if args.t1 is not None:
+        config = config.replace(window=TorqueFreeWindow(args.t1, args.t2))
+    if args.push is not None:
+        config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+
+    meshcat = None
+    if not args.no_animation:
+        meshcat = start_meshcat()
+        meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
+    bar, update = _progress_bar(config.sim.distance_m, "walk")
+    try:
+        result = run_episode(config, meshcat=meshcat, record_trajectory=True, progress=update)
+    finally:
+        bar.close()
+    result.to_json(out / "result.json")
+    if args.save_trajectory:
+        result.save_trajectory(out / "trajectory.npz")
+    try:
+        export_diagram(build_diagram(config).diagram, out)
+    except GraphvizMissingError as exc:
+        warn(str(exc))
+    window = config.window
+    title = (
+        f"C_mt {result.cost_of_transport:.3f}" if result.cost_of_transport is not None else "C_mt n/a"
+    ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
+    walk_figure(result.trajectory, out / "walk.png", title=title)
+    if meshcat is not None:
+        write_meshcat_html(meshcat, out / "walk.html")
+        walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
+    _print_summary(result)
+    print(f"wrote {out}/")
+    return 0
+
+
+def _print_summary(result) -> None:
+    status = f"FELL ({result.fall_reason})" if result.fell else f"ended: {result.termination}"
+    cmt = "n/a" if result.cost_of_transport is None else f"{result.cost_of_transport:.3f}"
+    cmt_kg = "n/a" if result.cost_of_transport_per_kg is None else f"{result.cost_of_transport_per_kg:.3f}"
+    period = "n/a" if result.step_period_s is None else f"{result.step_period_s:.3f} s"
+    length = "n/a" if result.step_length_m is None else f"{result.step_length_m:.3f} m"
+    print(
+        f"{status}: {result.distance_m:.2f} m in {result.duration_s:.2f} s ({result.mean_speed_mps:.3f} m/s), "
+        f"{len(result.steps)} steps, step {period} / {length}\n"
+        f"positive work {result.total_positive_work_j:.1f} J, C_mt {cmt} (E+/(m g d)), "
+        f"{cmt_kg} J/(kg m) (paper's eq. 1)\n"
+        f"wall {result.wall_time_s:.1f} s, real-time factor {result.real_time_factor:.2f}"
+    )
+
+
+def cmd_window_map(args: argparse.Namespace) -> int:
+    from drake_biped.window_map import run_window_map
+
+    config = _episode_config(args)
+    run_window_map(config, Path(args.out), t1_step=args.step, t2_step=args.step, workers=args.workers)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="drake-biped", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    walk = sub.add_parser("walk", help="walk one episode and write its record, figures and animation")
+    _add_episode_options(walk)
+    walk.add_argument("--t1", type=_number("nonnegative"), help="torque-free start after each step start (s)")
+    walk.add_argument("--t2", type=_number("nonnegative"), help="torque-free end (s); t2 <= t1: no window")
+    walk.add_argument("--push", type=_number("finite"), help="horizontal push on the torso (N, + forward)")
+    walk.add_argument("--push-start", type=_number("nonnegative"), default=0.4, help="push start (s); default 0.4")
+    walk.add_argument("--push-duration", type=_number("positive"), default=0.1, help="push duration (s); default 0.1")
+    walk.add_argument("--save-trajectory", action="store_true", help="also write trajectory.npz")
+    walk.add_argument("--no-animation", action="store_true", help="skip walk.html and walk.gif")
+    walk.add_argument("--out", required=True, help="output folder")
+    walk.set_defaults(func=cmd_walk)
+
+    wmap = sub.add_parser("window-map", help="C_mt of a grid of torque-free windows against no window")
+    _add_episode_options(wmap)
+    wmap.add_argument("--step", type=_number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
+    wmap.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    wmap.add_argument("--out", required=True, help="output folder")
+    wmap.set_defaults(func=cmd_window_map)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except ParameterError as exc:
+        parser.exit(2, f"drake-biped {args.command}: error: {exc}\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

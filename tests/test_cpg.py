@@ -1,0 +1,103 @@
+"""The CPG phase and the torque-free gate, as pure functions and inside the controller system."""
+
+import math
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+
+from drake_biped import controller as ctl
+from drake_biped import cpg
+from drake_biped.diagram import initial_state
+from drake_biped.params import CpgParams, EpisodeConfig, TorqueFreeWindow
+
+
+def test_output_is_equation_three_with_alpha_and_eta():
+    p = CpgParams(alpha=0.5, u_a=2.0, u_eta=0.3, u_r=2.1, kappa=0.0)
+    assert cpg.output(p, math.pi / 2) == pytest.approx(0.5 * 2.0 + 0.3)
+    assert cpg.output(CpgParams(), 1.0) == pytest.approx(2.0 * math.sin(1.0))  # Table III: eq. 3 exactly
+
+
+def test_swing_reference_endpoints_and_slope():
+    assert cpg.swing_reference(0.0, -0.3, 0.4) == pytest.approx(-0.3)
+    assert cpg.swing_reference(math.pi, -0.3, 0.4) == pytest.approx(0.4)
+    # d(phi_d)/dt = (phi_T - phi_0)/2 sin(gamma) u_r == zeta when phi_T - phi_0 = 2 u_a / u_r
+    p = CpgParams(u_a=2.0, u_r=4.0, kappa=0.0)
+    a = p.swing_amplitude_rad
+    g, h = 1.1, 1e-6
+    rate = (cpg.swing_reference(g + h, -a, a) - cpg.swing_reference(g - h, -a, a)) / (2 * h) * p.u_r
+    assert rate == pytest.approx(cpg.output(p, g), rel=1e-6)
+
+
+@pytest.mark.parametrize("t, start, end, inside", [
+    (0.25, 0.2, 0.5, True), (0.2, 0.2, 0.5, True), (0.5, 0.2, 0.5, False), (0.1, 0.2, 0.5, False),
+    (0.3, 0.5, 0.5, False), (0.3, 0.6, 0.2, False),
+])
+def test_window_membership(t, start, end, inside):
+    assert cpg.in_torque_free_window(t, start, end) is inside
+
+
+def _controller_alone(config, swing_lifted=True):
+    """The controller with a fixed plant state whose swing foot is high in the air (no touchdown)."""
+    q, v, stance_right, liftoff = initial_state(config)
+    q = q.copy()
+    q[1] += 0.05 if swing_lifted else 0.0
+    q[3] = -0.3  # left (swing) hip behind: its foot is also behind, so touchdown cannot be accepted
+    q[4] = 0.6
+    c = ctl.CpgWalkingController(config, stance_right, liftoff)
+    sim = Simulator(c)
+    ctx = sim.get_mutable_context()
+    c.get_input_port(0).FixValue(ctx, np.concatenate([q, v * 0.0]))
+    c.set_initial_state(ctx, q[3:], 0.0)
+    return c, sim, ctx
+
+
+def test_phase_matches_closed_form_when_kappa_is_zero():
+    config = EpisodeConfig(cpg=CpgParams(u_a=2.0, u_r=2.1, kappa=0.0))
+    c, sim, ctx = _controller_alone(config)
+    for t in (0.1, 0.5, 1.0, 1.4):
+        sim.AdvanceTo(t)
+        gamma = ctx.get_discrete_state(c.state_group).GetAtIndex(ctl.GAMMA)
+        # Updates at 0, dt, ..., t - dt have been applied by time t: gamma = u_r * t (Euler is exact here).
+        assert gamma == pytest.approx(min(cpg.closed_form_phase(config.cpg, t), math.pi), abs=1e-9)
+    sim.AdvanceTo(2.0)
+    assert ctx.get_discrete_state(c.state_group).GetAtIndex(ctl.GAMMA) == pytest.approx(math.pi)
+
+
+def test_kappa_feeds_stance_ankle_rate_into_phase():
+    config = EpisodeConfig(cpg=CpgParams(u_a=2.0, u_r=2.0, kappa=1.5))
+    c, sim, ctx = _controller_alone(config)
+    q, v, _, _ = initial_state(config)
+    x = c.get_input_port(0).Eval(ctx).copy()
+    x[9 + 8] = 0.4  # right (stance) ankle rate
+    c.get_input_port(0).FixValue(ctx, x)
+    sim.AdvanceTo(0.5)
+    assert ctx.get_discrete_state(c.state_group).GetAtIndex(ctl.GAMMA) == pytest.approx((2.0 + 1.5 * 0.4) * 0.5)
+
+
+def test_gate_zeroes_swing_hip_and_freezes_integrator():
+    window = TorqueFreeWindow(0.05, 0.12)
+    config = EpisodeConfig(window=window)
+    config = config.replace(gait=config.gait.__class__(**{**config.gait.to_dict(), "hip_ki": 50.0}))
+    c, sim, ctx = _controller_alone(config)
+    swing_hip = 0  # left hip: the left leg is the first swing leg
+    seen_in, seen_out = 0, 0
+    integral_at_start = None
+    t = 0.0
+    while t < 0.2:
+        t = round(t + config.sim.control_period_s, 9)
+        sim.AdvanceTo(t)
+        tau = ctx.get_discrete_state(0).value()
+        s = ctx.get_discrete_state(c.state_group).value()
+        last_update = t - config.sim.control_period_s  # the torque now held was computed at this time
+        if window.start_s <= last_update - 1e-9 and last_update < window.end_s - 1e-9:
+            assert tau[swing_hip] == 0.0
+            assert s[ctl.GATE] == 1.0
+            integral_at_start = s[ctl.INTEGRAL] if integral_at_start is None else integral_at_start
+            assert s[ctl.INTEGRAL] == integral_at_start
+            seen_in += 1
+        elif last_update > window.end_s + 1e-9 or last_update < window.start_s - 1e-9:
+            assert abs(tau[swing_hip]) > 0.1
+            assert s[ctl.GATE] == 0.0
+            seen_out += 1
+    assert seen_in >= 60 and seen_out >= 100

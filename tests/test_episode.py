@@ -1,0 +1,108 @@
+"""A short walk: it walks, its energy books balance, its record is complete."""
+
+import json
+
+import numpy as np
+import pytest
+
+from drake_biped.diagram import TorsoPush, build_diagram
+from drake_biped.episode import EpisodeResult, run_episode
+from drake_biped.model import build_plant
+from drake_biped.params import (
+    GRAVITY_MPS2,
+    TOTAL_MASS_KG,
+    EpisodeConfig,
+    Push,
+    SimulationParams,
+    TorqueFreeWindow,
+)
+
+
+def test_short_walk_does_not_fall(short_walk):
+    r = short_walk
+    assert not r.fell and r.termination == "distance"
+    assert r.distance_m >= 3.0
+    assert len(r.steps) >= 3
+    assert all(s.hip_angle_rad > 0 for s in r.steps)  # the leading leg is ahead at every touchdown
+    legs = [s.stance_leg for s in r.steps]
+    assert all(a != b for a, b in zip(legs, legs[1:]))  # legs alternate
+    assert r.cost_of_transport is not None and 0 < r.cost_of_transport < 5
+    assert r.cost_of_transport_per_kg == pytest.approx(GRAVITY_MPS2 * r.cost_of_transport)
+
+
+def test_in_simulation_work_equals_torque_times_displacement(short_walk):
+    """The integrator's positive work equals sum of max(tau_k * dq_k, 0) over the logged control steps."""
+    T = short_walk.trajectory
+    dq = np.diff(T["positions"][:, 3:], axis=0)
+    offline = np.maximum(T["actuation"][:-1] * dq, 0.0).sum(axis=0)
+    np.testing.assert_allclose(T["positive_work"][-1], offline, rtol=1e-9, atol=1e-9)
+
+
+def test_work_energy_theorem(short_walk):
+    """Motor work + gravity work - change of kinetic energy = energy dissipated (contact, limits) >= 0."""
+    T = short_walk.trajectory
+    plant = build_plant()
+    ctx = plant.CreateDefaultContext()
+
+    def energy(i):
+        plant.SetPositions(ctx, T["positions"][i])
+        plant.SetVelocities(ctx, T["velocities"][i])
+        com_z = plant.CalcCenterOfMassPositionInWorld(ctx)[2]
+        return plant.CalcKineticEnergy(ctx), com_z
+
+    ke0, z0 = energy(0)
+    ke1, z1 = energy(-1)
+    dq = np.diff(T["positions"][:, 3:], axis=0)
+    motor = float(np.sum(T["actuation"][:-1] * dq))
+    gravity = -TOTAL_MASS_KG * GRAVITY_MPS2 * (z1 - z0)
+    dissipated = motor + gravity - (ke1 - ke0)
+    positive = float(T["positive_work"][-1].sum())
+    assert dissipated > -0.02 * positive
+    assert dissipated < positive  # cannot lose more than the motors put in plus what gravity gave
+
+
+def test_window_gives_zero_swing_hip_torque_whenever_gated():
+    config = EpisodeConfig(window=TorqueFreeWindow(0.1, 0.3), sim=SimulationParams(distance_m=1.0, max_time_s=5.0))
+    r = run_episode(config, record_trajectory=True)
+    T = r.trajectory
+    gated = T["torque_free"] > 0.5
+    assert gated.sum() > 50
+    swing_hip = np.where(T["stance_right"] > 0.5, T["actuation"][:, 0], T["actuation"][:, 3])
+    assert np.all(swing_hip[gated] == 0.0)
+    assert np.any(np.abs(swing_hip[~gated]) > 1.0)
+
+
+def test_result_record_round_trips(short_walk, tmp_path):
+    path = tmp_path / "result.json"
+    short_walk.to_json(path)
+    data = json.loads(path.read_text())
+    for key in ("distance_m", "duration_s", "fell", "fall_reason", "steps", "positive_work_j",
+                "cost_of_transport", "cost_of_transport_per_kg", "mean_speed_mps", "config", "seed", "versions"):
+        assert key in data
+    assert data["versions"]["drake"]
+    assert set(data["steps"][0]) >= {"touchdown_time_s", "hip_angle_rad", "hip_rate_radps"}
+    again = EpisodeResult.from_dict(data)
+    assert again.distance_m == short_walk.distance_m
+    assert EpisodeConfig.from_dict(data["config"]) == EpisodeConfig.from_dict(short_walk.config)
+
+
+def test_same_config_same_numbers():
+    config = EpisodeConfig(sim=SimulationParams(distance_m=0.5, max_time_s=3.0), seed=7)
+    a, b = run_episode(config), run_episode(config)
+    assert a.positive_work_j == b.positive_work_j and a.distance_m == b.distance_m
+
+
+def test_push_delivers_its_impulse():
+    plant = build_plant()
+    push = TorsoPush(plant, Push(force_n=20.0, start_s=0.4, duration_s=0.1))
+    dt = 1e-4
+    ts = np.arange(0.0, 1.0, dt)
+    impulse = sum(push.force_at(t) for t in ts) * dt
+    assert impulse == pytest.approx(2.0, abs=2 * 20.0 * dt)
+    assert push.force_at(0.39) == 0.0 and push.force_at(0.45) == 20.0 and push.force_at(0.51) == 0.0
+
+
+def test_push_is_wired_only_when_requested():
+    names = lambda c: [s.get_name() for s in build_diagram(c).diagram.GetSystems()]  # noqa: E731
+    assert "torso_push" not in names(EpisodeConfig())
+    assert "torso_push" in names(EpisodeConfig(push=Push(20.0, 0.4, 0.1)))

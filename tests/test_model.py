@@ -1,0 +1,89 @@
+"""The plant read back from models/biped.urdf against Table I and the documented limits."""
+
+import math
+
+import numpy as np
+import pytest
+
+from drake_biped.model import JOINT_NAMES, ModelError, add_biped, build_plant, effort_limits
+from drake_biped.params import EFFORT_LIMITS_NM, TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG, TOTAL_MASS_KG, Ground
+
+
+@pytest.fixture(scope="module")
+def plant():
+    return build_plant()
+
+
+def test_total_mass_is_table_one(plant):
+    ctx = plant.CreateDefaultContext()
+    assert plant.CalcTotalMass(ctx) == pytest.approx(10.202, abs=1e-9)
+    assert TOTAL_MASS_KG == pytest.approx(10.202, abs=1e-9)
+
+
+@pytest.mark.parametrize("link", ["torso", "thigh", "shank", "foot"])
+def test_link_masses(plant, link):
+    names = [link] if link == "torso" else [f"left_{link}", f"right_{link}"]
+    for name in names:
+        assert plant.GetBodyByName(name).default_mass() == pytest.approx(TABLE_I_MASSES_KG[link])
+
+
+def test_link_lengths_from_joint_offsets(plant):
+    ctx = plant.CreateDefaultContext()
+    knee = plant.GetJointByName("left_knee").frame_on_parent().CalcPoseInBodyFrame(ctx).translation()
+    ankle = plant.GetJointByName("left_ankle").frame_on_parent().CalcPoseInBodyFrame(ctx).translation()
+    assert np.linalg.norm(knee) == pytest.approx(TABLE_I_LENGTHS_M["thigh"])
+    assert np.linalg.norm(ankle) == pytest.approx(TABLE_I_LENGTHS_M["shank"])
+    # Torso: its centre of mass sits at half its length above the hip.
+    assert plant.GetBodyByName("torso").default_com()[2] == pytest.approx(TABLE_I_LENGTHS_M["torso"] / 2)
+    # Foot: heel and toe contact points are the foot's length apart.
+    inspector_x = []
+    for body in ("left_foot",):
+        for gid in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(body)):
+            inspector_x.append(gid)
+    assert len(inspector_x) == 2
+
+
+def test_foot_contact_span(plant):
+    from drake_biped.params import HEEL_X_M, TOE_X_M
+
+    assert TOE_X_M - HEEL_X_M == pytest.approx(TABLE_I_LENGTHS_M["foot"])
+
+
+def test_joint_limits(plant):
+    for side in ("left", "right"):
+        hip = plant.GetJointByName(f"{side}_hip")
+        ankle = plant.GetJointByName(f"{side}_ankle")
+        knee = plant.GetJointByName(f"{side}_knee")
+        assert hip.position_lower_limits()[0] == pytest.approx(-math.radians(51), abs=1e-5)
+        assert hip.position_upper_limits()[0] == pytest.approx(math.radians(51), abs=1e-5)
+        assert ankle.position_lower_limits()[0] == pytest.approx(-math.radians(26), abs=1e-5)
+        assert ankle.position_upper_limits()[0] == pytest.approx(math.radians(26), abs=1e-5)
+        assert knee.position_lower_limits()[0] == 0.0  # no hyper-extension
+
+
+def test_effort_limits_match_params(plant):
+    limits = effort_limits(plant)
+    expected = [EFFORT_LIMITS_NM[n.split("_")[1]] for n in JOINT_NAMES]
+    np.testing.assert_allclose(limits, expected)
+
+
+def test_only_feet_collide(plant):
+    bodies = {plant.GetBodyFromFrameId(plant.GetBodyFrameIdOrThrow(b.index())).name()
+              for b in [plant.get_body(i) for i in plant.GetBodyIndices(plant.GetModelInstanceByName("biped"))]
+              if plant.GetCollisionGeometriesForBody(b)}
+    assert bodies == {"left_foot", "right_foot"}
+
+
+def test_malformed_model_is_a_clear_error(tmp_path):
+    from pydrake.systems.framework import DiagramBuilder
+
+    bad = tmp_path / "package.xml"
+    bad.write_text('<?xml version="1.0"?><package format="2"><name>drake_biped</name></package>')
+    (tmp_path / "biped.urdf").write_text("<robot name='x'><link name='a'></robot>")
+    with pytest.raises(ModelError, match="could not parse"):
+        add_biped(DiagramBuilder(), Ground(), 1e-3, package_xml=bad)
+
+
+def test_piecewise_ground_builds(tmp_path):
+    plant = build_plant(Ground(slope_rad=0.02, level_length_m=2.0))
+    assert plant.is_finalized()

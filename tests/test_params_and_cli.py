@@ -1,0 +1,67 @@
+"""Bad input gets a clear error naming the value."""
+
+import math
+
+import pytest
+
+from drake_biped.cli import main
+from drake_biped.params import (
+    CpgParams,
+    EpisodeConfig,
+    Ground,
+    ParameterError,
+    SimulationParams,
+    TorqueFreeWindow,
+)
+
+
+def test_nan_parameter_named():
+    with pytest.raises(ParameterError, match="u_r"):
+        CpgParams(u_r=math.nan)
+
+
+def test_out_of_range_parameter_named():
+    with pytest.raises(ParameterError, match=r"start_s = -0.1"):
+        TorqueFreeWindow(-0.1, 0.5)
+    with pytest.raises(ParameterError, match="distance_m"):
+        SimulationParams(distance_m=-1.0)
+
+
+def test_unknown_parameter_named():
+    with pytest.raises(ParameterError, match="bogus"):
+        EpisodeConfig.from_dict({"cpg": {"bogus": 1.0}})
+
+
+def test_descending_piecewise_ground_rejected():
+    with pytest.raises(ParameterError, match="slope_rad"):
+        Ground(slope_rad=-0.02, level_length_m=2.0)
+
+
+def test_ground_height_and_slope():
+    assert Ground().height(3.0) == 0.0
+    assert Ground(slope_rad=0.1).height(2.0) == pytest.approx(2.0 * math.tan(0.1))
+    g = Ground(slope_rad=0.02, level_length_m=2.0)
+    assert g.height(1.5) == 0.0 and g.slope_at(1.5) == 0.0
+    assert g.height(3.0) == pytest.approx(math.tan(0.02)) and g.slope_at(3.0) == 0.02
+
+
+def test_config_round_trip():
+    c = EpisodeConfig(window=TorqueFreeWindow(0.2, 0.5), seed=3)
+    assert EpisodeConfig.from_dict(c.to_dict()) == c
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["walk", "--distance", "-1", "--out", "x"], "'-1' must be > 0"),
+    (["walk", "--distance", "nan", "--out", "x"], "'nan' is not a finite number"),
+    (["walk", "--t1", "-0.1", "--t2", "0.5", "--out", "x"], "'-0.1' must be >= 0"),
+    (["walk", "--t1", "0.2", "--out", "x"], "--t1 and --t2 go together"),
+    (["walk", "--bogus", "--out", "x"], "--bogus"),
+    (["walk", "--slope", "0.9", "--out", "x"], "slope_rad = 0.9"),
+])
+def test_cli_rejects_bad_input(argv, needle, capsys, tmp_path):
+    argv = [a if a != "x" else str(tmp_path / "out") for a in argv]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert needle in capsys.readouterr().err
+    assert not (tmp_path / "out" / "result.json").exists()
