@@ -1,0 +1,36 @@
+# One-word commands. `make walk` and `make test` set everything up on a fresh machine first.
+VENV ?= .venv
+PY := $(VENV)/bin/python
+OUT ?= out
+
+.PHONY: setup walk test test-fast lint format window-map clean
+
+setup: $(VENV)/.installed
+
+$(VENV)/.installed: pyproject.toml
+	@command -v dot >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    apt-get update -qq && apt-get install -y -qq graphviz >/dev/null; \
+	  else echo "note: Graphviz 'dot' is missing; diagram.svg/png will not be drawn (apt-get install graphviz)"; fi; }
+	python3 -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $@
+
+walk: setup
+	$(VENV)/bin/drake-biped walk --out $(OUT)/walk
+
+test: setup
+	$(PY) -m pytest -q
+
+lint: setup
+	$(VENV)/bin/ruff check .
+
+format: setup
+	$(VENV)/bin/ruff format .
+
+window-map: setup
+	$(VENV)/bin/drake-biped window-map --out $(OUT)/window-map
+
+clean:
+	rm -rf $(OUT) .pytest_cache
