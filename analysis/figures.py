@@ -112,6 +112,7 @@ def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: 
         label.set_text(f"t = {t[idx[k]]:.2f} s")
         return (*artists.values(), ground_line, label)
 
+    fig.subplots_adjust(bottom=0.17, top=0.97)
     anim = FuncAnimation(fig, draw, frames=n_frames, blit=False)
     anim.save(path, writer=PillowWriter(fps=fps))
     plt.close(fig)

@@ -156,7 +156,7 @@ class CpgWalkingController(LeafSystem):
         s[GATE] = 1.0 if gated else 0.0
         tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
 
-        tau_swing_knee = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + 1]), _KNEE_LIMIT)
+        tau_swing_knee = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + 1], swing.thigh_angle), _KNEE_LIMIT)
         tau_stance_knee = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
 
         tau = [0.0] * 6

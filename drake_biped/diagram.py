@@ -58,17 +58,20 @@ def initial_state(config: EpisodeConfig) -> tuple[np.ndarray, np.ndarray, bool, 
     """The paper's initiation: q, v, whether the right leg is the first stance leg, the swing lift-off angle.
 
     The initial hip angle is the angle between the thighs (the inter-leg angle of the Poincare section):
-    torso upright, right thigh at +hip_angle/2 (front, stance), left at -hip_angle/2 (rear, swing), knees
+    the torso at its reference lean (GaitParams.torso_pitch_rad, so the torso servo starts at rest), the
+    right thigh at +hip_angle/2 from vertical (front, stance), the left at -hip_angle/2 (rear, swing), knees
     straight, feet parallel to the ground, lowest contact point 0.1 mm above it; every body moves forward
     at the initial speed (a horizontal velocity of the floating base with zero joint rates)."""
     a = 0.5 * config.initial.hip_angle_rad
     slope0 = config.ground.slope_at(0.0)
+    pitch = config.gait.torso_pitch_rad
     q = np.zeros(9)
-    q[3], q[6] = -a, a
+    q[2] = pitch
+    q[3], q[6] = -a - pitch, a - pitch  # thigh world angles -a, +a
     q[5], q[8] = slope0 + a, slope0 - a  # foot angle = thigh - knee + ankle = local slope
     lowest = math.inf
     for i in (3, 6):
-        p = leg_points(0.0, 0.0, 0.0, q[i], q[i + 1], q[i + 2])
+        p = leg_points(0.0, 0.0, pitch, q[i], q[i + 1], q[i + 2])
         for px, pz in ((p.heel_x, p.heel_z), (p.toe_x, p.toe_z)):
             lowest = min(lowest, pz - config.ground.height(px))
     q[1] = -lowest + 1e-4

@@ -32,10 +32,12 @@ def placement_target(gait: GaitParams, amplitude: float, hip_ahead_of_stance_m: 
     return amplitude + gait.placement_gain * hip_ahead_of_stance_m + gait.placement_velocity_gain * hip_speed
 
 
-def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float) -> float:
-    """Bang-bang swing knee: flex early in the swing (until the knee reaches its flexion limit), then
-    extend once the CPG phase passes knee_extend_phase."""
-    if gamma < gait.knee_extend_phase and knee_angle < gait.knee_flex_max_rad:
+def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float, thigh_angle: float) -> float:
+    """Bang-bang swing knee: flex towards knee_flex_max_rad (extending whenever it is past it) until
+    the CPG phase has passed knee_extend_phase and the thigh is ahead of knee_extend_thigh_rad (the
+    clearance guard); then extend until touchdown."""
+    extend = gamma >= gait.knee_extend_phase and thigh_angle >= gait.knee_extend_thigh_rad
+    if not extend and knee_angle < gait.knee_flex_max_rad:
         return gait.knee_flex_torque
     return -gait.knee_extend_torque
 

@@ -133,12 +133,16 @@ class GaitParams(_Validated):
     torso_kp: float = 280.0  # N*m/rad
     torso_kd: float = 28.0  # N*m*s/rad
     torso_pitch_rad: float = -0.06
-    # Swing knee, bang-bang: flex until the CPG phase passes knee_extend_phase (or the knee reaches
-    # knee_flex_max_rad), then extend until touchdown. Stance knee: constant extending torque.
+    # Swing knee, bang-bang: flex towards knee_flex_max_rad until the CPG phase passes knee_extend_phase
+    # and the thigh is ahead by knee_extend_thigh_rad, then extend until touchdown.
+    # Stance knee: constant extending torque.
     knee_flex_torque: float = 4.4  # N*m
     knee_extend_torque: float = 9.3  # N*m
     knee_extend_phase: float = 1.64  # rad of CPG phase
     knee_flex_max_rad: float = 0.48
+    # Clearance guard: the knee extends only once the swing thigh is this far ahead of vertical (rad),
+    # so a swing slowed by the torque-free period does not put its toe into the ground mid-swing.
+    knee_extend_thigh_rad: float = -1.0
     stance_knee_torque: float = 17.7  # N*m
     # Ankles: PD keeping each foot parallel to the local ground.
     ankle_kp: float = 20.0  # N*m/rad
@@ -162,6 +166,7 @@ class GaitParams(_Validated):
         "knee_extend_torque": (0.0, 30.0),
         "knee_extend_phase": (0.0, math.pi),
         "knee_flex_max_rad": (0.0, 2.4),
+        "knee_extend_thigh_rad": (-1.0, 1.0),
         "stance_knee_torque": (0.0, 30.0),
         "ankle_kp": (0.0, 500.0),
         "ankle_kd": (0.0, 50.0),
