@@ -145,7 +145,9 @@ class CpgWalkingController(LeafSystem):
         angle_error = reference - swing.thigh_angle
 
         # Torque-free gate: exactly zero swing-hip torque, integrator frozen.
-        gated = cpg.in_torque_free_window(time_in_step, self._window.start_s, self._window.end_s)
+        gated = s[STEP_COUNT] >= self._window.first_step and cpg.in_torque_free_window(
+            time_in_step, self._window.start_s, self._window.end_s
+        )
         if gated:
             tau_swing_hip = 0.0
         else:

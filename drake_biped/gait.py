@@ -33,13 +33,19 @@ def placement_target(gait: GaitParams, amplitude: float, hip_ahead_of_stance_m: 
 
 
 def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float, thigh_angle: float) -> float:
-    """Bang-bang swing knee: flex towards knee_flex_max_rad (extending whenever it is past it) until
-    the CPG phase has passed knee_extend_phase and the thigh is ahead of knee_extend_thigh_rad (the
-    clearance guard); then extend until touchdown."""
-    extend = gamma >= gait.knee_extend_phase and thigh_angle >= gait.knee_extend_thigh_rad
-    if not extend and knee_angle < gait.knee_flex_max_rad:
+    """Bang-bang swing knee with a passive middle.
+
+    Extend once the CPG phase has passed knee_extend_phase and the thigh is ahead of
+    knee_extend_thigh_rad (the clearance guard); before that, extend whenever the knee is past
+    knee_flex_max_rad, flex while the phase is below knee_flex_until_phase, and otherwise apply no
+    torque (the knee swings passively)."""
+    if gamma >= gait.knee_extend_phase and thigh_angle >= gait.knee_extend_thigh_rad:
+        return -gait.knee_extend_torque
+    if knee_angle >= gait.knee_flex_max_rad:
+        return -gait.knee_extend_torque
+    if gamma < gait.knee_flex_until_phase:
         return gait.knee_flex_torque
-    return -gait.knee_extend_torque
+    return 0.0
 
 
 def ankle_torque(gait: GaitParams, foot_angle: float, foot_rate: float, ground_angle: float) -> float:

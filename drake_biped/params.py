@@ -133,8 +133,9 @@ class GaitParams(_Validated):
     torso_kp: float = 280.0  # N*m/rad
     torso_kd: float = 28.0  # N*m*s/rad
     torso_pitch_rad: float = -0.06
-    # Swing knee, bang-bang: flex towards knee_flex_max_rad until the CPG phase passes knee_extend_phase
-    # and the thigh is ahead by knee_extend_thigh_rad, then extend until touchdown.
+    # Swing knee, bang-bang: flex (below knee_flex_max_rad) until the CPG phase passes
+    # knee_flex_until_phase, then passive, then extend once the phase passes knee_extend_phase and the
+    # thigh is ahead by knee_extend_thigh_rad, until touchdown.
     # Stance knee: constant extending torque.
     knee_flex_torque: float = 4.4  # N*m
     knee_extend_torque: float = 9.3  # N*m
@@ -143,6 +144,9 @@ class GaitParams(_Validated):
     # Clearance guard: the knee extends only once the swing thigh is this far ahead of vertical (rad),
     # so a swing slowed by the torque-free period does not put its toe into the ground mid-swing.
     knee_extend_thigh_rad: float = -1.0
+    # Flexing stops once the CPG phase passes this (rad); from there until extension the knee is
+    # passive (zero torque), swinging as in ballistic walking. pi: flex until extension.
+    knee_flex_until_phase: float = math.pi
     stance_knee_torque: float = 17.7  # N*m
     # Ankles: PD keeping each foot parallel to the local ground.
     ankle_kp: float = 20.0  # N*m/rad
@@ -167,6 +171,7 @@ class GaitParams(_Validated):
         "knee_extend_phase": (0.0, math.pi),
         "knee_flex_max_rad": (0.0, 2.4),
         "knee_extend_thigh_rad": (-1.0, 1.0),
+        "knee_flex_until_phase": (0.0, math.pi),
         "stance_knee_torque": (0.0, 30.0),
         "ankle_kp": (0.0, 500.0),
         "ankle_kd": (0.0, 50.0),
@@ -199,8 +204,17 @@ class TorqueFreeWindow(_Validated):
 
     start_s: float = 0.0
     end_s: float = 0.0
+    # The window acts from step `first_step` on. Step 0 is the initiation (from the initial state to
+    # the first touchdown T_1); the paper's controller, and so its torque-free period, is about the
+    # maintenance phase that follows.
+    first_step: int = 1
 
     _RANGES = {"start_s": (0.0, 10.0), "end_s": (0.0, 10.0)}
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.first_step, int) or isinstance(self.first_step, bool) or self.first_step < 0:
+            raise ParameterError(f"TorqueFreeWindow.first_step must be an integer >= 0, got {self.first_step!r}")
 
     @property
     def active(self) -> bool:
@@ -314,6 +328,32 @@ _NESTED = {
     ("EpisodeConfig", "sim"): SimulationParams,
 }
 
-# The gait this toolkit walks by default (see README, "Model and controller choices").
-DEFAULT_CPG = CpgParams(alpha=1.0, u_a=3.26, u_eta=0.0, u_r=8.59, kappa=1.69)
-DEFAULT_GAIT = GaitParams()
+# The gait this toolkit walks by default (see README, "Model and controller choices"): found by an
+# evolutionary search (u_a = 0.3527 * u_r) for a gait that walks 10 m and in which torque-free windows
+# lower C_mt. Values at 4 significant digits; the walking region is narrow, so keep them together.
+DEFAULT_CPG = CpgParams(alpha=1.0, u_a=1.6291, u_eta=0.0, u_r=4.619, kappa=2.603)
+DEFAULT_GAIT = GaitParams(
+    hip_kp=100.1,
+    hip_kd=14.92,
+    hip_ki=0.0,
+    placement_gain=0.356,
+    placement_velocity_gain=0.1445,
+    torso_kp=280.0,
+    torso_kd=28.0,
+    torso_pitch_rad=-0.2226,
+    knee_flex_torque=4.338,
+    knee_extend_torque=5.369,
+    knee_extend_phase=2.603,
+    knee_flex_max_rad=0.8625,
+    knee_extend_thigh_rad=0.3144,
+    knee_flex_until_phase=0.5624,
+    stance_knee_torque=17.7,
+    ankle_kp=20.0,
+    ankle_kd=0.3,
+    touchdown_min_step_s=0.15,
+    touchdown_height_m=0.002,
+    touchdown_min_advance_m=0.05,
+    touchdown_min_phase=1.671,
+)
+# A second initiation, closer to the gait's limit cycle: every acceptance window walks 10 m from it.
+CYCLE_INITIAL = InitialConditions(hip_angle_rad=0.5027, speed_mps=0.5977)

@@ -76,7 +76,7 @@ def test_kappa_feeds_stance_ankle_rate_into_phase():
 
 
 def test_gate_zeroes_swing_hip_and_freezes_integrator():
-    window = TorqueFreeWindow(0.05, 0.12)
+    window = TorqueFreeWindow(0.05, 0.12, first_step=0)
     config = EpisodeConfig(window=window)
     config = config.replace(gait=config.gait.__class__(**{**config.gait.to_dict(), "hip_ki": 50.0}))
     c, sim, ctx = _controller_alone(config)

@@ -19,6 +19,15 @@ def test_swing_knee(gamma, knee, thigh, expected):
     assert gait.swing_knee_torque(G, gamma, knee, thigh) == expected
 
 
+def test_swing_knee_passive_middle():
+    g = GaitParams(knee_flex_torque=5.0, knee_extend_torque=7.0, knee_extend_phase=2.5, knee_flex_max_rad=1.2,
+                   knee_extend_thigh_rad=0.2, knee_flex_until_phase=1.0)
+    assert gait.swing_knee_torque(g, 0.5, 0.3, -0.3) == 5.0  # flexion burst
+    assert gait.swing_knee_torque(g, 1.5, 0.8, -0.1) == 0.0  # passive
+    assert gait.swing_knee_torque(g, 1.5, 1.3, -0.1) == -7.0  # limit guard
+    assert gait.swing_knee_torque(g, 2.6, 0.8, 0.3) == -7.0  # extension
+
+
 def test_touchdown_needs_every_condition():
     ok = dict(time_in_step_s=0.5, swing_clearance_m=0.001, swing_ankle_advance_m=0.2, gamma=2.0)
     g = GaitParams(touchdown_min_step_s=0.15, touchdown_height_m=0.002, touchdown_min_advance_m=0.05,
