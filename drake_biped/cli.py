@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk`, `drake-biped window-map`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -184,6 +184,27 @@ def cmd_window_map(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_gait_search(args: argparse.Namespace) -> int:
+    from drake_biped.gait_search import run_search
+
+    config = _episode_config(args)
+    result = run_search(config, Path(args.out), generations=args.generations, offspring=args.offspring,
+                        sigma=args.sigma, seed=config.seed, distance_m=config.sim.distance_m
+                        if args.distance is not None else 6.0, workers=args.workers)
+    print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
+    return 0
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="drake-biped", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -203,9 +224,18 @@ def build_parser() -> argparse.ArgumentParser:
     wmap = sub.add_parser("window-map", help="C_mt of a grid of torque-free windows against no window")
     _add_episode_options(wmap)
     wmap.add_argument("--step", type=_number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
-    wmap.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    wmap.add_argument("--workers", type=_count, default=2, help="parallel processes (default 2)")
     wmap.add_argument("--out", required=True, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
+
+    search = sub.add_parser("gait-search", help="evolve gait parameters for walking and torque-free savings")
+    _add_episode_options(search)
+    search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
+    search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
+    search.add_argument("--sigma", type=_number("positive"), default=0.1, help="mutation scale (default 0.1)")
+    search.add_argument("--workers", type=_count, default=2, help="parallel processes (default 2)")
+    search.add_argument("--out", required=True, help="output folder (rerun to resume)")
+    search.set_defaults(func=cmd_gait_search)
     return parser
 
 

@@ -1,0 +1,170 @@
+"""Search CPG and gait parameters for a gait that walks and in which torque-free windows save energy.
+
+A (1 + lambda) evolution strategy: each generation mutates the parent `offspring` times (log-normal steps
+for positive gains, Gaussian steps for angles and phases), scores every child, and keeps the best child
+if it scores at least as well as the parent. This is how `params.DEFAULT_CPG`/`DEFAULT_GAIT` were found
+(from a walker of an earlier random search; see README).
+
+Score of a configuration: -9 if it does not walk `distance_m` without a window; otherwise the largest
+fractional C_mt saving among the scored windows that also walk (-0.3 if none walks), plus 0.03 for every
+window that walks. Every generation is appended to `search.jsonl`; a rerun resumes from its last line.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import random
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.versions import versions
+
+ACCEPTANCE_WINDOWS = ((0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7))
+# (section, field): (kind, step at sigma = 0.1, lower bound, upper bound)
+MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
+    ("cpg", "u_a"): ("log", 0.1, 0.05, 20.0),
+    ("cpg", "u_r"): ("log", 0.1, 0.5, 30.0),
+    ("cpg", "kappa"): ("log", 0.1, 0.0, 9.0),
+    ("gait", "hip_kp"): ("log", 0.1, 1.0, 2000.0),
+    ("gait", "hip_kd"): ("log", 0.1, 0.1, 200.0),
+    ("gait", "placement_gain"): ("log", 0.1, 0.0, 4.9),
+    ("gait", "placement_velocity_gain"): ("log", 0.1, 0.0, 4.9),
+    ("gait", "knee_flex_torque"): ("log", 0.1, 0.1, 30.0),
+    ("gait", "knee_extend_torque"): ("log", 0.1, 0.1, 30.0),
+    ("gait", "knee_flex_max_rad"): ("log", 0.1, 0.05, 2.4),
+    ("gait", "knee_flex_until_phase"): ("add", 0.1, 0.0, math.pi),
+    ("gait", "knee_extend_phase"): ("add", 0.1, 0.5, 3.1),
+    ("gait", "knee_extend_thigh_rad"): ("add", 0.04, -0.9, 0.9),
+    ("gait", "torso_pitch_rad"): ("add", 0.015, -0.45, 0.0),
+    ("gait", "touchdown_min_phase"): ("add", 0.1, 0.3, 3.1),
+}
+
+
+def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1) -> EpisodeConfig:
+    """A child of `config`: every parameter in MUTATIONS moved by a random step scaled by sigma / 0.1."""
+    sections = {"cpg": config.cpg.to_dict(), "gait": config.gait.to_dict()}
+    for (section, name), (kind, step, lo, hi) in MUTATIONS.items():
+        value = sections[section][name]
+        if kind == "log":
+            value = value * math.exp(rng.gauss(0.0, step * sigma / 0.1))
+        else:
+            value = value + rng.gauss(0.0, step * sigma / 0.1)
+        sections[section][name] = min(hi, max(lo, value))
+    return config.replace(
+        cpg=type(config.cpg)(**sections["cpg"]), gait=type(config.gait)(**sections["gait"])
+    )
+
+
+def _walk(config: EpisodeConfig) -> dict[str, Any]:
+    from drake_biped.episode import run_episode
+
+    r = run_episode(config)
+    return {
+        "walked": (not r.fell) and r.distance_m >= config.sim.distance_m - 1e-6,
+        "cost_of_transport": r.cost_of_transport,
+        "distance_m": r.distance_m,
+    }
+
+
+def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS) -> tuple[float, dict[str, Any]]:
+    """The search objective (module docstring) and what it measured."""
+    base = _walk(config.replace(window=TorqueFreeWindow()))
+    if not base["walked"]:
+        return -9.0, {"baseline": base, "windows": []}
+    rows = []
+    for t1, t2 in windows:
+        row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
+        row["window"] = [t1, t2]
+        rows.append(row)
+    savings = [1.0 - r["cost_of_transport"] / base["cost_of_transport"] for r in rows if r["walked"]]
+    value = (max(savings) if savings else -0.3) + 0.03 * len(savings)
+    return value, {"baseline": base, "windows": rows}
+
+
+def _child(args) -> tuple[dict, float, dict]:
+    parent_dict, seed, sigma, windows = args
+    child = mutate(EpisodeConfig.from_dict(parent_dict), random.Random(seed), sigma)
+    value, detail = score(child, windows)
+    return child.to_dict(), value, detail
+
+
+def run_search(
+    start: EpisodeConfig,
+    out: Path,
+    generations: int = 50,
+    offspring: int = 4,
+    sigma: float = 0.1,
+    seed: int = 0,
+    distance_m: float = 6.0,
+    windows=ACCEPTANCE_WINDOWS,
+    workers: int = 2,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Evolve from `start`; write `search.jsonl` (one line per generation) and `best_config.json`."""
+    if generations < 1 or offspring < 1 or not sigma > 0 or not distance_m > 0:
+        raise ParameterError(
+            f"generations ({generations!r}) and offspring ({offspring!r}) must be >= 1, "
+            f"sigma ({sigma!r}) and distance_m ({distance_m!r}) > 0"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    log = out / "search.jsonl"
+    start = start.replace(sim=dataclasses.replace(start.sim, distance_m=distance_m,
+                                                  max_time_s=max(start.sim.max_time_s, 6.0 * distance_m)))
+    windows = [tuple(w) for w in windows]
+    first = 1
+    records = _read_log(log)
+    if records:
+        last = records[-1]
+        parent, parent_score, first = last["parent"], last["parent_score"], last["generation"] + 1
+    else:
+        parent = start.to_dict()
+        parent_score, detail = score(start, windows)
+        _append(log, {"generation": 0, "parent": parent, "parent_score": parent_score, "detail": detail,
+                      "seed": seed, "sigma": sigma, "versions": versions()})
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=generations, initial=min(first - 1, generations), desc="search", unit="gen")
+    with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+        for gen in range(first, generations + 1):
+            jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows) for k in range(offspring)]
+            children = list(pool.map(_child, jobs))
+            best_dict, best_score, best_detail = max(children, key=lambda c: c[1])
+            if best_score >= parent_score:
+                parent, parent_score = best_dict, best_score
+            _append(log, {"generation": gen, "parent": parent, "parent_score": parent_score,
+                          "best_child_score": best_score, "child_scores": [c[1] for c in children],
+                          "best_child_detail": best_detail})
+            if bar is not None:
+                bar.update(1)
+                bar.set_postfix_str(f"score {parent_score:+.3f}")
+    if bar is not None:
+        bar.close()
+    (out / "best_config.json").write_text(json.dumps(parent, indent=2) + "\n")
+    return {"parent": parent, "score": parent_score}
+
+
+def _read_log(path: Path) -> list[dict]:
+    """The finished generations; a last line cut short by a kill is dropped (and rewritten away)."""
+    if not path.exists():
+        return []
+    records, lines = [], path.read_text().splitlines()
+    for i, line in enumerate(lines):
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            if i != len(lines) - 1:
+                raise
+            path.write_text("".join(json.dumps(r) + "\n" for r in records))
+    return records
+
+
+def _append(path: Path, record: dict) -> None:
+    with open(path, "a") as f:
+        f.write(json.dumps(record) + "\n")
+        f.flush()
