@@ -180,7 +180,7 @@ def run_episode(
     cmt_kg = cost_of_transport_per_kg(positive["total"], TOTAL_MASS_KG, distance)
     trajectory = _trajectory(parts, context) if record_trajectory else None
     return EpisodeResult(
-        config=_config_dict(config),
+        config=config.to_dict(),
         distance_m=float(distance),
         duration_s=float(t_end),
         fell=fell,
@@ -201,11 +201,6 @@ def run_episode(
         versions=versions(),
         trajectory=trajectory,
     )
-
-
-def _config_dict(config: EpisodeConfig) -> dict[str, Any]:
-    d = asdict(config)
-    return d
 
 
 def extract_steps(parts: BipedDiagram, context) -> list[StepRecord]:
