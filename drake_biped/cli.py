@@ -154,7 +154,8 @@ def cmd_walk(args: argparse.Namespace) -> int:
     ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
     walk_figure(result.trajectory, out / "walk.png", title=title)
     if meshcat is not None:
-        write_meshcat_html(meshcat, out / "walk.html")
+        x = result.trajectory["positions"][:, 0]
+        write_meshcat_html(meshcat, out / "walk.html", x_range=(float(x.min()), float(x.max())))
         walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
     _print_summary(result)
     print(f"wrote {out}/")

@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 from pydrake.systems.framework import Diagram
 
 
@@ -44,10 +45,17 @@ def start_meshcat():
     return Meshcat(params)
 
 
-def write_meshcat_html(meshcat, path: Path) -> None:
-    """Publish the recording and save Meshcat's self-contained HTML page."""
+def write_meshcat_html(meshcat, path: Path, x_range: tuple[float, float] | None = None) -> None:
+    """Publish the recording and save Meshcat's self-contained HTML page.
+
+    x_range: the stretch of ground the walk covered (m); the camera looks at it from the side, so the
+    whole walk is in view (press play under "Open Controls" > Animations to watch it)."""
     meshcat.StopRecording()
     meshcat.PublishRecording()
+    if x_range is not None:
+        x_mid = 0.5 * (x_range[0] + x_range[1])
+        distance = 0.65 * abs(x_range[1] - x_range[0]) + 2.0
+        meshcat.SetCameraPose(np.array([x_mid, -distance, 0.9]), np.array([x_mid, 0.0, 0.35]))
     Path(path).write_text(meshcat.StaticHtml())
 
 
