@@ -39,14 +39,22 @@ def _number(kind: str):
     return parse
 
 
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
-    return value
+def _integer(minimum: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r} must be >= {minimum}")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
+
+
+_seed = _integer(0)
+_count = _integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser) -> None:
@@ -194,16 +202,6 @@ def cmd_gait_search(args: argparse.Namespace) -> int:
                         if args.distance is not None else 6.0, workers=args.workers)
     print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
     return 0
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
-    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
