@@ -20,7 +20,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_biped import cpg, gait
-from drake_biped.kinematics import center_of_mass, leg_points
+from drake_biped.kinematics import center_of_mass_from_legs, leg_points
 from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
 
 # Layout of the "controller_state" discrete group.
@@ -104,7 +104,7 @@ class CpgWalkingController(LeafSystem):
                 s[POSITIVE_WORK + i] += w
             s[Q_PREV + i] = q[3 + i]
 
-        if not all(math.isfinite(val) for val in x):
+        if not math.isfinite(sum(x)):  # a NaN or an infinity anywhere makes the sum non-finite
             s[FALL] = 4.0
             discrete_state.get_mutable_vector(self._torque_group).SetZero()
             discrete_state.get_mutable_vector(self._state_group).SetFromVector(s)
@@ -179,7 +179,7 @@ class CpgWalkingController(LeafSystem):
             s[FALL] = 2.0
         elif min(left.knee_z - ground.height(left.knee_x), right.knee_z - ground.height(right.knee_x)) < 0.0:
             s[FALL] = 3.0
-        s[COM_X] = center_of_mass(q)[0]
+        s[COM_X] = center_of_mass_from_legs(px, pz, pitch, left, right)[0]
 
         discrete_state.get_mutable_vector(self._torque_group).SetFromVector(tau)
         discrete_state.get_mutable_vector(self._state_group).SetFromVector(s)

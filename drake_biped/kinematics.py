@@ -66,11 +66,17 @@ def leg_points(x: float, z: float, pitch: float, hip: float, knee: float, ankle:
 def center_of_mass(q) -> tuple[float, float]:
     """Whole-body centre of mass (x, z) for q = (x, z, pitch, hipL, kneeL, ankleL, hipR, kneeR, ankleR)."""
     x, z, pitch = q[0], q[1], q[2]
+    return center_of_mass_from_legs(
+        x, z, pitch, leg_points(x, z, pitch, q[3], q[4], q[5]), leg_points(x, z, pitch, q[6], q[7], q[8])
+    )
+
+
+def center_of_mass_from_legs(x: float, z: float, pitch: float, left: LegPoints, right: LegPoints) -> tuple[float, float]:
+    """Centre of mass from the hip position, torso pitch and both legs' points (already computed)."""
     mt, mth, msh, mft = (TABLE_I_MASSES_KG[k] for k in ("torso", "thigh", "shank", "foot"))
     sx = mt * (x - 0.5 * TORSO_M * math.sin(pitch))
     sz = mt * (z + 0.5 * TORSO_M * math.cos(pitch))
-    for i in (3, 6):
-        p = leg_points(x, z, pitch, q[i], q[i + 1], q[i + 2])
+    for p in (left, right):
         sx += mth * 0.5 * (x + p.knee_x) + msh * 0.5 * (p.knee_x + p.ankle_x)
         sz += mth * 0.5 * (z + p.knee_z) + msh * 0.5 * (p.knee_z + p.ankle_z)
         c, s = math.cos(p.foot_angle), math.sin(p.foot_angle)

@@ -78,6 +78,26 @@ def test_malformed_model_is_a_clear_error(tmp_path):
         add_biped(DiagramBuilder(), Ground(), 1e-3, package_xml=bad)
 
 
-def test_piecewise_ground_builds(tmp_path):
-    plant = build_plant(Ground(slope_rad=0.02, level_length_m=2.0))
-    assert plant.is_finalized()
+@pytest.mark.parametrize("ground, x, expected_height", [
+    (Ground(), 3.0, 0.0),
+    (Ground(slope_rad=0.05), 3.0, 3.0 * math.tan(0.05)),
+    (Ground(slope_rad=0.02, level_length_m=2.0), 1.5, 0.0),
+    (Ground(slope_rad=0.02, level_length_m=2.0), 4.0, 2.0 * math.tan(0.02)),
+])
+def test_ground_geometry_matches_its_height_function(ground, x, expected_height):
+    """SceneGraph's signed distance from a point above the ground equals the height above the surface
+    (measured along the normal), for level, tilted and level-then-slope ground."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    builder = DiagramBuilder()
+    handles = add_biped(builder, ground, 1e-3)
+    diagram = builder.Build()
+    ctx = diagram.CreateDefaultContext()
+    query = handles.scene_graph.get_query_output_port().Eval(handles.scene_graph.GetMyContextFromRoot(ctx))
+    z = 1.0
+    inspector = query.inspector()
+    distances = [d.distance for d in query.ComputeSignedDistanceToPoint(np.array([x, 0.0, z]))
+                 if inspector.GetName(d.id_G).endswith(("ground", "ground_level", "ground_slope"))]
+    slope = ground.slope_at(x)
+    assert ground.height(x) == pytest.approx(expected_height)
+    assert min(distances) == pytest.approx((z - expected_height) * math.cos(slope), abs=1e-9)
