@@ -28,7 +28,6 @@ class TorsoPush(LeafSystem):
         self._force = ExternallyAppliedSpatialForce()
         self._force.body_index = torso.index()
         self._force.p_BoBq_B = torso.default_com()
-        self._on = [self._force]
         self.DeclareAbstractOutputPort(
             "spatial_forces",
             lambda: AbstractValue.Make([ExternallyAppliedSpatialForce()]),

@@ -37,11 +37,11 @@ def test_window_membership(t, start, end, inside):
     assert cpg.in_torque_free_window(t, start, end) is inside
 
 
-def _controller_alone(config, swing_lifted=True):
+def _controller_alone(config):
     """The controller with a fixed plant state whose swing foot is high in the air (no touchdown)."""
     q, v, stance_right, liftoff = initial_state(config)
     q = q.copy()
-    q[1] += 0.05 if swing_lifted else 0.0
+    q[1] += 0.05
     q[3] = -0.3  # left (swing) hip behind: its foot is also behind, so touchdown cannot be accepted
     q[4] = 0.6
     c = ctl.CpgWalkingController(config, stance_right, liftoff)

@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from analysis.cost_of_transport import positive_work
 from drake_biped.diagram import TorsoPush, build_diagram
 from drake_biped.episode import EpisodeResult, run_episode
 from drake_biped.model import build_plant
@@ -31,10 +32,13 @@ def test_short_walk_does_not_fall(short_walk):
 
 
 def test_in_simulation_work_equals_torque_times_displacement(short_walk):
-    """The integrator's positive work equals sum of max(tau_k * dq_k, 0) over the logged control steps."""
+    """The integrator's positive work equals analysis.positive_work over the logged control steps
+    (torque held over each step, joint rate = displacement / step): the audit anyone can run on
+    trajectory.npz."""
     T = short_walk.trajectory
-    dq = np.diff(T["positions"][:, 3:], axis=0)
-    offline = np.maximum(T["actuation"][:-1] * dq, 0.0).sum(axis=0)
+    dt = float(np.diff(T["time"])[0])
+    omega = np.diff(T["positions"][:, 3:], axis=0) / dt
+    offline = positive_work(T["actuation"][:-1], omega, dt)
     np.testing.assert_allclose(T["positive_work"][-1], offline, rtol=1e-9, atol=1e-9)
 
 
