@@ -10,7 +10,8 @@ from pydrake.common.value import AbstractValue
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import LogVectorOutput, VectorLogSink
+from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, VectorLogSink
+from pydrake.trajectories import PiecewisePolynomial
 
 from drake_biped.controller import CpgWalkingController
 from drake_biped.kinematics import leg_points
@@ -110,3 +111,28 @@ def build_diagram(config: EpisodeConfig, meshcat=None, log_period_s: float | Non
     diagram = builder.Build()
     diagram.set_name("drake_biped")
     return BipedDiagram(diagram, plant, controller, state_log, controller_log, actuation_log)
+
+
+def build_replay_diagram(
+    config: EpisodeConfig, times: np.ndarray, torques: np.ndarray
+) -> tuple[Diagram, MultibodyPlant]:
+    """The plant alone, driven by a zero-order hold of logged torques (no controller, no Python).
+
+    times (n,) and torques (n, 6) are an actuation log sampled at the control period: torque k acts over
+    [times[k], times[k] + period). Replayed from the same initial state at the same time step, it reproduces
+    the closed-loop trajectory, so the plant sees exactly the closed loop's contacts: the reference against
+    which the controller's cost is measured.
+    """
+    times = np.asarray(times, dtype=float)
+    torques = np.asarray(torques, dtype=float)
+    if times.ndim != 1 or torques.shape != (times.size, 6) or times.size < 1:
+        raise ValueError(f"expected times (n,) and torques (n, 6), got {times.shape} and {torques.shape}")
+    builder = DiagramBuilder()
+    plant = add_biped(builder, config.ground, config.sim.time_step_s).plant
+    breaks = np.append(times, times[-1] + config.sim.control_period_s)
+    hold = PiecewisePolynomial.ZeroOrderHold(breaks, np.vstack([torques, torques[-1:]]).T)
+    source = builder.AddNamedSystem("logged_torques", TrajectorySource(hold))
+    builder.Connect(source.get_output_port(), plant.get_actuation_input_port())
+    diagram = builder.Build()
+    diagram.set_name("drake_biped_replay")
+    return diagram, plant

@@ -1,0 +1,243 @@
+"""Speed of the walking episode: plant alone vs closed loop per time step, episodes per minute, Dask 1 vs 2
+workers, import and build time, peak memory per worker.
+
+    python benchmarks/bench.py --out out/bench            # about 3 minutes on 2 cores
+    python benchmarks/bench.py --out out/bench --quick    # one repeat, two time steps, 2 m, small Dask run
+
+Writes OUT/benchmarks.json (every sample, with the versions and the machine) and OUT/benchmarks.md (tables).
+
+Plant alone: the same MultibodyPlant with the same contact, driven by a zero-order hold of the closed
+loop's logged torques (a built-in TrajectorySource; no Python during the simulation). From the same initial
+state at the same time step it retraces the closed-loop walk exactly, so both see the same contacts.
+Real-time factor = simulated time / wall time of Simulator.AdvanceTo (building the diagram excluded).
+Episodes per minute counts the whole `run_episode` call (build, simulate, summarise).
+The measurements of the different time steps are interleaved within each repeat, so a change in machine
+load affects all of them alike; tables give medians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from drake_biped.diagram import build_replay_diagram, initial_state
+from drake_biped.episode import run_episode
+from drake_biped.parallel import dask_client, episode_task, map_ordered, peak_rss_mb
+from drake_biped.params import EpisodeConfig, SimulationParams, TorqueFreeWindow
+from drake_biped.versions import versions
+
+DASK_WINDOWS = [None, (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.1, 0.5), (0.2, 0.6), (0.1, 0.3), (0.2, 0.4)]
+
+
+def config_at(step: float, distance: float, window: tuple[float, float] | None = None) -> EpisodeConfig:
+    """The default gait at plant and control step `step`, walking `distance` metres."""
+    sim = SimulationParams(time_step_s=step, control_period_s=step, distance_m=distance)
+    w = TorqueFreeWindow(*window) if window else TorqueFreeWindow(0.0, 0.0)
+    return EpisodeConfig(sim=sim, window=w)
+
+
+def time_import(module: str, repeats: int) -> list[float]:
+    code = f"import time; t = time.perf_counter(); import {module}; print(time.perf_counter() - t)"
+    out = []
+    for _ in range(repeats):
+        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+        out.append(float(run.stdout.strip().splitlines()[-1]))
+    return out
+
+
+def time_build(config: EpisodeConfig, repeats: int) -> list[float]:
+    from pydrake.systems.analysis import Simulator
+
+    from drake_biped.diagram import build_diagram
+
+    out = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        parts = build_diagram(config)
+        Simulator(parts.diagram).Initialize()
+        out.append(time.perf_counter() - t)
+    return out
+
+
+def replay(config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, duration: float) -> tuple[float, np.ndarray]:
+    """Wall time of the plant alone over `duration`, and its final positions."""
+    from pydrake.systems.analysis import Simulator
+
+    diagram, plant = build_replay_diagram(config, times, torques)
+    simulator = Simulator(diagram)
+    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    q0, v0, _, _ = initial_state(config)
+    plant.SetPositions(plant_context, q0)
+    plant.SetVelocities(plant_context, v0)
+    simulator.Initialize()
+    t = time.perf_counter()
+    simulator.AdvanceTo(duration)
+    return time.perf_counter() - t, plant.GetPositions(plant_context)
+
+
+def real_time_factors(steps: list[float], distance: float, repeats: int) -> dict:
+    """Plant alone vs closed loop at each time step, interleaved, `repeats` rounds."""
+    logged = {}
+    for h in steps:
+        r = run_episode(config_at(h, distance), record_trajectory=True)
+        logged[h] = r
+        print(f"  recorded {h * 1e3:g} ms: {r.duration_s:.2f} s simulated, {r.distance_m:.2f} m, fell={r.fell}")
+    samples = {h: {"plant": [], "closed": [], "episode_wall": [], "replay_error_m": None} for h in steps}
+    for k in range(repeats):
+        for h in steps:
+            ref = logged[h]
+            cfg = config_at(h, distance)
+            wall, q_end = replay(cfg, ref.trajectory["time"], ref.trajectory["actuation"], ref.duration_s)
+            samples[h]["plant"].append(ref.duration_s / wall)
+            samples[h]["replay_error_m"] = float(np.max(np.abs(q_end[:2] - ref.trajectory["positions"][-1][:2])))
+            t = time.perf_counter()
+            r = run_episode(cfg)
+            samples[h]["episode_wall"].append(time.perf_counter() - t)
+            samples[h]["closed"].append(r.real_time_factor)
+            print(f"  round {k + 1}/{repeats} {h * 1e3:g} ms: plant {samples[h]['plant'][-1]:.2f}x, "
+                  f"closed loop {r.real_time_factor:.2f}x", flush=True)
+    rows = []
+    for h in steps:
+        s = samples[h]
+        plant, closed = statistics.median(s["plant"]), statistics.median(s["closed"])
+        rows.append({
+            "time_step_s": h,
+            "simulated_s": logged[h].duration_s,
+            "distance_m": logged[h].distance_m,
+            "fell": logged[h].fell,
+            "plant_alone_rtf": plant,
+            "closed_loop_rtf": closed,
+            "ratio": closed / plant,
+            "episode_wall_s": statistics.median(s["episode_wall"]),
+            "episodes_per_min": 60.0 / statistics.median(s["episode_wall"]),
+            "replay_max_position_error_m": s["replay_error_m"],
+            "samples": {key: s[key] for key in ("plant", "closed", "episode_wall")},
+        })
+    return {"distance_m": distance, "repeats": repeats, "rows": rows}
+
+
+def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> list[dict]:
+    configs = [config_at(1e-3, distance, DASK_WINDOWS[i % len(DASK_WINDOWS)]).to_dict() for i in range(n_episodes)]
+    out = []
+    for n in worker_counts:
+        t0 = time.perf_counter()
+        with dask_client(workers=n) as client:
+            started = time.perf_counter() - t0
+            client.submit(sum, [1, 2]).result()  # workers are up and answering
+            t1 = time.perf_counter()
+            results = map_ordered(client, episode_task, configs)
+            wall = time.perf_counter() - t1
+        out.append({
+            "workers": n,
+            "episodes": n_episodes,
+            "cluster_start_s": started,
+            "wall_s": wall,
+            "episodes_per_min": 60.0 * n_episodes / wall,
+            "peak_rss_mb_per_worker": max(r["worker_peak_rss_mb"] for r in results),
+            "simulated_s": sum(r["duration_s"] for r in results),
+            "cost_of_transport": [r["cost_of_transport"] for r in results],
+        })
+        print(f"  dask {n} worker(s): {n_episodes} episodes in {wall:.1f} s "
+              f"({out[-1]['episodes_per_min']:.1f}/min), peak {out[-1]['peak_rss_mb_per_worker']:.0f} MB/worker")
+    if len(out) == 2:
+        same = out[0]["cost_of_transport"] == out[1]["cost_of_transport"]
+        out[1]["same_results_as_first"] = same
+    return out
+
+
+def markdown(record: dict) -> str:
+    lines = [
+        "# drake-biped benchmarks",
+        "",
+        f"{record['machine']['cpus']} CPUs, {record['machine']['platform']}, Python {record['machine']['python']}, "
+        f"Drake {record['versions']['drake']}, commit {record['versions']['git_commit']}, {record['date']}.",
+        "",
+        f"## Real-time factor, {record['rtf']['distance_m']:g} m walk (default gait, no window), "
+        f"median of {record['rtf']['repeats']}",
+        "",
+        "| time step | simulated | plant alone | closed loop | closed / plant | episode wall | episodes/min |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in record["rtf"]["rows"]:
+        lines.append(
+            f"| {r['time_step_s'] * 1e3:g} ms | {r['simulated_s']:.2f} s{' (fell)' if r['fell'] else ''} | "
+            f"{r['plant_alone_rtf']:.2f}× | {r['closed_loop_rtf']:.2f}× | {r['ratio']:.2f} | "
+            f"{r['episode_wall_s']:.2f} s | {r['episodes_per_min']:.1f} |"
+        )
+    lines += ["", "Plant alone: the same plant replaying the closed loop's logged torques (largest final position "
+              "difference from the closed loop: "
+              + ", ".join(f"{r['replay_max_position_error_m']:.1e} m" for r in record["rtf"]["rows"]) + ")."]
+    if record.get("dask"):
+        lines += ["", "## Dask LocalCluster, 1 ms, 10 m episodes with assorted windows", "",
+                  "| workers | episodes | wall | episodes/min | speed-up | cluster start | peak memory/worker |",
+                  "|---|---|---|---|---|---|---|"]
+        base = record["dask"][0]["episodes_per_min"]
+        for d in record["dask"]:
+            lines.append(
+                f"| {d['workers']} | {d['episodes']} | {d['wall_s']:.1f} s | {d['episodes_per_min']:.1f} | "
+                f"{d['episodes_per_min'] / base:.2f}× | {d['cluster_start_s']:.1f} s | {d['peak_rss_mb_per_worker']:.0f} MB |"
+            )
+    imp, build = record["import_s"], record["build_s"]
+    lines += [
+        "",
+        "## Start-up",
+        "",
+        f"- `import pydrake.all`: {statistics.median(imp['pydrake.all']):.2f} s; "
+        f"`import drake_biped.episode`: {statistics.median(imp['drake_biped.episode']):.2f} s "
+        f"(fresh interpreter, median of {len(imp['pydrake.all'])})",
+        f"- build the diagram + Simulator.Initialize: {statistics.median(build):.3f} s (median of {len(build)})",
+        f"- peak memory of this process: {record['peak_rss_mb_main']:.0f} MB",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--out", type=Path, default=Path("out/bench"))
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--distance", type=float, default=10.0)
+    p.add_argument("--steps", default="0.0005,0.001,0.002,0.005", help="time steps (s), comma-separated")
+    p.add_argument("--dask-episodes", type=int, default=8, help="0 skips the Dask runs")
+    p.add_argument("--quick", action="store_true", help="one repeat, 1 and 2 ms, 2 m, 2 Dask episodes")
+    args = p.parse_args(argv)
+    steps = [float(s) for s in args.steps.split(",")]
+    repeats, distance, n_dask = args.repeats, args.distance, args.dask_episodes
+    if args.quick:
+        steps, repeats, distance, n_dask = [1e-3, 2e-3], 1, 2.0, 2
+    if repeats < 1 or distance <= 0 or n_dask < 0 or any(h <= 0 for h in steps):
+        p.error("--repeats >= 1, --distance > 0, --dask-episodes >= 0 and positive --steps are required")
+    args.out.mkdir(parents=True, exist_ok=True)
+
+    print("import and build times")
+    record = {
+        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+        "versions": versions(),
+        "machine": {"cpus": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()},
+        "import_s": {m: time_import(m, 3) for m in ("pydrake.all", "drake_biped.episode")},
+        "build_s": time_build(EpisodeConfig(), 5),
+    }
+    print("real-time factors")
+    record["rtf"] = real_time_factors(steps, distance, repeats)
+    if n_dask:
+        print("dask")
+        record["dask"] = dask_runs([1, 2], n_dask, 10.0 if not args.quick else distance)
+    record["peak_rss_mb_main"] = peak_rss_mb()
+    (args.out / "benchmarks.json").write_text(json.dumps(record, indent=2) + "\n")
+    table = markdown(record)
+    (args.out / "benchmarks.md").write_text(table)
+    print(table)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

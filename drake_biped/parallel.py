@@ -1,0 +1,104 @@
+"""Run independent episodes on Dask: an embedded LocalCluster by default, or an existing scheduler.
+
+Workers receive numbers (EpisodeConfig dictionaries), never Drake objects, and build their own diagrams.
+Scripts that start a LocalCluster spawn worker processes, so their entry point needs the
+`if __name__ == "__main__":` guard.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+import resource
+import sys
+import time
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any
+
+from drake_biped.params import ParameterError
+
+_ADDRESS = re.compile(r"^(tcp|tls|inproc|ucx)://[^\s/]+(:\d+)?$")
+
+
+def check_scheduler_address(address: str) -> str:
+    """The address unchanged, or ParameterError naming it (expected form: tcp://HOST:PORT)."""
+    if not isinstance(address, str) or not _ADDRESS.match(address):
+        raise ParameterError(f"--scheduler {address!r}: expected an address like tcp://HOST:PORT")
+    return address
+
+
+@contextmanager
+def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator[Any]:
+    """A `distributed.Client`: on `scheduler` when given, else on a LocalCluster of `workers` processes.
+
+    The local cluster binds to 127.0.0.1 only, runs one thread per worker (Drake episodes are CPU-bound
+    and hold the GIL), and has no dashboard. Defaults to one worker per core.
+    """
+    from distributed import Client, LocalCluster
+
+    logging.getLogger("distributed").setLevel(logging.WARNING)
+    if scheduler is not None:
+        if workers is not None:
+            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+        client = Client(check_scheduler_address(scheduler), timeout="20s")
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
+    n = workers or max(1, os.cpu_count() or 1)
+    cluster = LocalCluster(
+        n_workers=n,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+        silence_logs=40,
+    )
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+def peak_rss_mb() -> float:
+    """Peak resident memory of this process (MB)."""
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return rss / 1024.0 if sys.platform != "darwin" else rss / 2**20
+
+
+def episode_task(config: dict[str, Any]) -> dict[str, Any]:
+    """Run one episode from an EpisodeConfig dictionary; its result dictionary plus worker bookkeeping."""
+    from drake_biped.episode import run_episode
+    from drake_biped.params import EpisodeConfig
+
+    t0 = time.perf_counter()
+    result = run_episode(EpisodeConfig.from_dict(config)).to_dict()
+    result["task_wall_time_s"] = time.perf_counter() - t0
+    result["worker_peak_rss_mb"] = peak_rss_mb()
+    return result
+
+
+def map_ordered(
+    client: Any,
+    fn: Callable[[Any], Any],
+    items: Sequence[Any],
+    progress: Callable[[int, Any], None] | None = None,
+) -> list[Any]:
+    """fn over items on the cluster, results in the items' order; progress(done, result) as each finishes."""
+    from distributed import as_completed
+
+    futures = client.map(fn, list(items), pure=False)
+    index = {f.key: i for i, f in enumerate(futures)}
+    results: list[Any] = [None] * len(futures)
+    for done, future in enumerate(as_completed(futures), start=1):
+        results[index[future.key]] = future.result()
+        if progress is not None:
+            progress(done, results[index[future.key]])
+    return results
