@@ -3,13 +3,22 @@
 One periodic discrete update per control period does all the work: it advances the CPG phase (eq. 2),
 detects touchdown and swaps the legs (resetting the phase), applies the torque-free gate, computes the six
 joint torques (swing-hip PID on the CPG reference, torso balance through the stance hip, bang-bang swing
-knee, constant stance-knee torque, ankles flat to the ground), and integrates the motor work. The torques
-are held in a discrete-state group exported with DeclareStateOutputPort, so the plant reads them without
-calling back into Python.
+knee, constant stance-knee torque, ankles flat to the ground), integrates the motor work, records each
+touchdown's Poincare section state, and ends the episode (an EventStatus the Simulator obeys) on a fall or
+when the centre of mass has walked the distance. The torques are held in a discrete-state group exported
+with DeclareStateOutputPort, so the plant reads them at its own rate without calling back into Python.
 
 Input port:  "plant_state" (18): MultibodyPlant state q (9), v (9).
 Output ports: "actuation" (6): joint torques (N*m), JOINT_NAMES order, applied by the plant.
               "controller_state" (N_STATE): phase, roles, step bookkeeping, work integrals, fall flag.
+Discrete groups: actuation (6), controller state (N_STATE), touchdowns (capacity x TOUCHDOWN_FIELDS).
+
+Timing: the plant's output ports are sampled (Drake's default for a discrete plant), so the state the
+update at context time t reads is the plant state at t + h, h the plant time step, and the torques it
+computes act from t + h on: state feedback without delay. The touchdown times and STATE_TIME are the
+times of the states read, which are also the time stamps the state log gives those states; the CPG phase
+and the torque-free window count from STEP_START, the context time of the touchdown update.
+tests/test_hot_path.py pins this down.
 """
 
 from __future__ import annotations
@@ -17,7 +26,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
 from drake_biped import cpg, gait
 from drake_biped.kinematics import center_of_mass_from_legs, leg_points
@@ -32,11 +41,20 @@ STEP_COUNT = 4  # touchdowns so far
 INTEGRAL = 5  # hip PID integrator (rad*s)
 GATE = 6  # 1.0 while the swing hip is torque-free
 FALL = 7  # fall code, see FALL_REASONS
-COM_X = 8  # whole-body centre of mass x (m)
-Q_PREV = 9  # 6 joint angles at the previous update
-POSITIVE_WORK = 15  # 6 per-joint integrals of max(tau * omega, 0) dt (J)
-SIGNED_WORK = 21  # 6 per-joint integrals of tau * omega dt (J)
-N_STATE = 27
+COM_X = 8  # whole-body centre of mass x at the last update (m)
+TARGET_X = 9  # the episode ends when COM_X reaches this (m)
+DONE = 10  # 1.0 once the distance is walked
+STATE_TIME = 11  # time of the plant state read by the last update (s)
+Q_PREV = 12  # 6 joint angles at the previous update
+TAU = 18  # 6 torques held since the previous update (N*m), a copy of the actuation group
+POSITIVE_WORK = 24  # 6 per-joint integrals of max(tau * omega, 0) dt (J)
+SIGNED_WORK = 30  # 6 per-joint integrals of tau * omega dt (J)
+N_STATE = 36
+
+# One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
+TOUCHDOWN_FIELDS = ("time_s", "hip_angle_rad", "hip_rate_radps", "stance_right", "com_x_m")
+_TD = len(TOUCHDOWN_FIELDS)
+MAX_TOUCHDOWNS = 4096
 
 FALL_REASONS = {
     0: "",
@@ -45,6 +63,13 @@ FALL_REASONS = {
     3: "knee touched the ground",
     4: "non-finite state",
 }
+
+
+def touchdown_capacity(config: EpisodeConfig) -> int:
+    """Rows reserved for touchdowns: enough for the whole episode at the shortest accepted step."""
+    shortest = max(config.gait.touchdown_min_step_s, config.sim.control_period_s)
+    return min(MAX_TOUCHDOWNS, int(math.ceil(config.sim.max_time_s / shortest)) + 1)
+
 
 _HIP_LIMIT = EFFORT_LIMITS_NM["hip"]
 _KNEE_LIMIT = EFFORT_LIMITS_NM["knee"]
@@ -62,16 +87,20 @@ class CpgWalkingController(LeafSystem):
         self._ground = config.ground
         self._window = config.window
         self._dt = config.sim.control_period_s
+        self._state_lag = config.sim.time_step_s  # see "Timing" above
         self._amplitude = config.cpg.swing_amplitude_rad
         self._fall_height = config.sim.fall_hip_height_m
         self._fall_pitch = config.sim.fall_pitch_rad
+        self._capacity = touchdown_capacity(config)
 
         self._plant_state = self.DeclareVectorInputPort("plant_state", 18)
         initial = np.zeros(N_STATE)
         initial[STANCE_RIGHT] = 1.0 if initial_stance_right else 0.0
         initial[LIFTOFF_ANGLE] = initial_liftoff_angle
+        initial[TARGET_X] = math.inf
         self._torque_group = self.DeclareDiscreteState(6)
         self._state_group = self.DeclareDiscreteState(BasicVector(initial))
+        self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
         self.DeclareStateOutputPort("actuation", self._torque_group)
         self.DeclareStateOutputPort("controller_state", self._state_group)
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
@@ -80,25 +109,32 @@ class CpgWalkingController(LeafSystem):
     def state_group(self) -> int:
         return int(self._state_group)
 
-    def set_initial_state(self, context, joint_angles, com_x: float) -> None:
-        """Seed the work integrator's previous angles and the centre-of-mass x from the initial state."""
+    def set_initial_state(self, context, joint_angles, com_x: float, distance_m: float = math.inf) -> None:
+        """Seed the work integrator's previous angles, the centre-of-mass x, and the distance to walk."""
         s = context.get_mutable_discrete_state(self._state_group)
         s.SetAtIndex(COM_X, com_x)
+        s.SetAtIndex(TARGET_X, com_x + distance_m)
         for i in range(6):
             s.SetAtIndex(Q_PREV + i, float(joint_angles[i]))
 
-    def _update(self, context, discrete_state) -> None:
+    def touchdowns(self, context) -> np.ndarray:
+        """The recorded touchdowns, one row each (columns: TOUCHDOWN_FIELDS)."""
+        n = min(int(context.get_discrete_state(self._state_group).GetAtIndex(STEP_COUNT)), self._capacity)
+        rows = context.get_discrete_state(self._touchdown_group).value()[: n * _TD]
+        return rows.reshape(n, _TD).copy()
+
+    def _update(self, context, discrete_state):
         t = context.get_time()
         x = self._plant_state.Eval(context).tolist()
         s = context.get_discrete_state(self._state_group).value().tolist()
-        tau_prev = context.get_discrete_state(self._torque_group).value().tolist()
         g = self._gait
+        s[STATE_TIME] = t + self._state_lag
         q, v = x[:9], x[9:]
 
         # Work done by the held torques since the last update: tau is constant over the interval,
         # so its work on each joint is exactly tau * (q_now - q_prev).
         for i in range(6):
-            w = tau_prev[i] * (q[3 + i] - s[Q_PREV + i])
+            w = s[TAU + i] * (q[3 + i] - s[Q_PREV + i])
             s[SIGNED_WORK + i] += w
             if w > 0.0:
                 s[POSITIVE_WORK + i] += w
@@ -106,9 +142,10 @@ class CpgWalkingController(LeafSystem):
 
         if not math.isfinite(sum(x)):  # a NaN or an infinity anywhere makes the sum non-finite
             s[FALL] = 4.0
-            discrete_state.get_mutable_vector(self._torque_group).SetZero()
-            discrete_state.get_mutable_vector(self._state_group).SetFromVector(s)
-            return
+            s[TAU : TAU + 6] = [0.0] * 6
+            discrete_state.set_value(self._torque_group, np.array(s[TAU : TAU + 6]))
+            discrete_state.set_value(self._state_group, np.array(s))
+            return EventStatus.ReachedTermination(self, FALL_REASONS[4])
 
         px, pz, pitch = q[0], q[1], q[2]
         pitch_rate = v[2]
@@ -117,8 +154,10 @@ class CpgWalkingController(LeafSystem):
         stance_right = s[STANCE_RIGHT] > 0.5
         st_i, sw_i = (6, 3) if stance_right else (3, 6)
         stance, swing = (right, left) if stance_right else (left, right)
+        com_x = center_of_mass_from_legs(px, pz, pitch, left, right)[0]
+        s[COM_X] = com_x
 
-        # Touchdown: swap the roles and reset the CPG phase (phase resetting).
+        # Touchdown: swap the roles, reset the CPG phase (phase resetting), record the section state.
         time_in_step = t - s[STEP_START]
         ground = self._ground
         clearance = min(swing.heel_z - ground.height(swing.heel_x), swing.toe_z - ground.height(swing.toe_x))
@@ -127,10 +166,16 @@ class CpgWalkingController(LeafSystem):
             stance_right = not stance_right
             st_i, sw_i = sw_i, st_i
             stance, swing = swing, stance
+            n = int(s[STEP_COUNT])
+            if n < self._capacity:
+                row = (t + self._state_lag, q[st_i] - q[sw_i], v[st_i] - v[sw_i], 1.0 if stance_right else 0.0, com_x)
+                td = discrete_state.get_mutable_vector(self._touchdown_group)
+                for k in range(_TD):
+                    td.SetAtIndex(n * _TD + k, row[k])
             s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
             s[STEP_START] = t
             s[LIFTOFF_ANGLE] = swing.thigh_angle
-            s[STEP_COUNT] += 1.0
+            s[STEP_COUNT] = n + 1.0
             s[GAMMA] = 0.0
             s[INTEGRAL] = 0.0
             time_in_step = 0.0
@@ -158,28 +203,31 @@ class CpgWalkingController(LeafSystem):
         s[GATE] = 1.0 if gated else 0.0
         tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
 
-        tau_swing_knee = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + 1], swing.thigh_angle), _KNEE_LIMIT)
-        tau_stance_knee = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
-
-        tau = [0.0] * 6
-        a_sw, a_st = sw_i - 3, st_i - 3
-        tau[a_sw] = tau_swing_hip
-        tau[a_st] = tau_stance_hip
-        tau[a_sw + 1] = tau_swing_knee
-        tau[a_st + 1] = tau_stance_knee
+        a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3
+        s[a_sw] = tau_swing_hip
+        s[a_st] = tau_stance_hip
+        s[a_sw + 1] = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + 1], swing.thigh_angle), _KNEE_LIMIT)
+        s[a_st + 1] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
         for leg, i in ((swing, sw_i), (stance, st_i)):
             foot_rate = pitch_rate + v[i] - v[i + 1] + v[i + 2]
             slope = ground.slope_at(leg.ankle_x)
-            tau[i - 3 + 2] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
+            s[TAU + i - 1] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
 
-        # Fall detection (read by the episode monitor).
+        # Fall detection and the end of the episode.
         if pz - ground.height(px) < self._fall_height:
             s[FALL] = 1.0
         elif abs(pitch) > self._fall_pitch:
             s[FALL] = 2.0
         elif min(left.knee_z - ground.height(left.knee_x), right.knee_z - ground.height(right.knee_x)) < 0.0:
             s[FALL] = 3.0
-        s[COM_X] = center_of_mass_from_legs(px, pz, pitch, left, right)[0]
+        if com_x >= s[TARGET_X]:
+            s[DONE] = 1.0
 
-        discrete_state.get_mutable_vector(self._torque_group).SetFromVector(tau)
-        discrete_state.get_mutable_vector(self._state_group).SetFromVector(s)
+        # Lists convert to Eigen element by element; a numpy array is copied in one go.
+        discrete_state.set_value(self._torque_group, np.array(s[TAU : TAU + 6]))
+        discrete_state.set_value(self._state_group, np.array(s))
+        if s[FALL] != 0.0:
+            return EventStatus.ReachedTermination(self, FALL_REASONS[int(s[FALL])])
+        if s[DONE] != 0.0:
+            return EventStatus.ReachedTermination(self, "distance reached")
+        return None

@@ -49,9 +49,9 @@ class BipedDiagram:
     diagram: Diagram
     plant: MultibodyPlant
     controller: CpgWalkingController
-    state_log: VectorLogSink
-    controller_log: VectorLogSink
-    actuation_log: VectorLogSink
+    state_log: VectorLogSink | None = None
+    controller_log: VectorLogSink | None = None
+    actuation_log: VectorLogSink | None = None
 
 
 def initial_state(config: EpisodeConfig) -> tuple[np.ndarray, np.ndarray, bool, float]:
@@ -80,10 +80,14 @@ def initial_state(config: EpisodeConfig) -> tuple[np.ndarray, np.ndarray, bool, 
     return q, v, True, -a
 
 
-def build_diagram(config: EpisodeConfig, meshcat=None, log_period_s: float | None = None) -> BipedDiagram:
-    """Plant + SceneGraph + controller (+ push) + loggers, as a named Diagram.
+def build_diagram(
+    config: EpisodeConfig, meshcat=None, record: bool = False, log_period_s: float | None = None
+) -> BipedDiagram:
+    """Plant + SceneGraph + controller (+ push) (+ loggers), as a named Diagram.
 
-    log_period_s: sampling period of the state/actuation/controller logs (default: the control period).
+    record: add loggers of the plant state, the controller state and the actuation, sampled every
+    log_period_s (default: the control period). Without them the diagram keeps only what an episode's
+    summary needs (the controller's own state: work integrals, touchdowns, fall flag).
     """
     builder = DiagramBuilder()
     handles = add_biped(builder, config.ground, config.sim.time_step_s)
@@ -95,13 +99,16 @@ def build_diagram(config: EpisodeConfig, meshcat=None, log_period_s: float | Non
     if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:
         push = builder.AddNamedSystem("torso_push", TorsoPush(plant, config.push))
         builder.Connect(push.get_output_port(), plant.get_applied_spatial_force_input_port())
-    period = log_period_s or config.sim.control_period_s
-    state_log = LogVectorOutput(plant.get_state_output_port(), builder, period)
-    state_log.set_name("state_log")
-    controller_log = LogVectorOutput(controller.GetOutputPort("controller_state"), builder, period)
-    controller_log.set_name("controller_log")
-    actuation_log = LogVectorOutput(controller.GetOutputPort("actuation"), builder, period)
-    actuation_log.set_name("actuation_log")
+    logs: dict[str, VectorLogSink] = {}
+    if record:
+        period = log_period_s or config.sim.control_period_s
+        for name, port in (
+            ("state_log", plant.get_state_output_port()),
+            ("controller_log", controller.GetOutputPort("controller_state")),
+            ("actuation_log", controller.GetOutputPort("actuation")),
+        ):
+            logs[name] = LogVectorOutput(port, builder, period)
+            logs[name].set_name(name)
     if meshcat is not None:
         from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams, Role
 
@@ -110,7 +117,7 @@ def build_diagram(config: EpisodeConfig, meshcat=None, log_period_s: float | Non
         )
     diagram = builder.Build()
     diagram.set_name("drake_biped")
-    return BipedDiagram(diagram, plant, controller, state_log, controller_log, actuation_log)
+    return BipedDiagram(diagram, plant, controller, **logs)
 
 
 def build_replay_diagram(

@@ -96,10 +96,16 @@ def simulate(
     config: EpisodeConfig,
     meshcat=None,
     progress: Callable[[float, float], None] | None = None,
+    record: bool = False,
     log_period_s: float | None = None,
 ) -> tuple[BipedDiagram, Simulator, str, float]:
-    """Build and run the diagram; return it, the simulator, the termination reason and the wall time."""
-    parts = build_diagram(config, meshcat=meshcat, log_period_s=log_period_s)
+    """Build and run the diagram; return it, the simulator, the termination reason and the wall time.
+
+    The controller ends the episode itself (a fall, or the distance walked); the Simulator runs no Python
+    between control updates unless `progress` asks for reports (every 0.25 simulated s).
+    Reasons: "distance", "fall", "time limit", or "simulation failed: ..." (a diverging contact solve).
+    """
+    parts = build_diagram(config, meshcat=meshcat, record=record, log_period_s=log_period_s)
     simulator = Simulator(parts.diagram)
     root = simulator.get_mutable_context()
     plant_ctx = parts.plant.GetMyMutableContextFromRoot(root)
@@ -108,36 +114,28 @@ def simulate(
     parts.plant.SetVelocities(plant_ctx, v0)
     com_x0 = center_of_mass(q0)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
-    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0)
+    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m)
     group = parts.controller.state_group
-    target = com_x0 + config.sim.distance_m
-    diagram = parts.diagram
-    reason = ["time limit"]
-    next_report = [0.0]
+    if progress is not None:
+        next_report = [0.0]
 
-    def monitor(context):
-        s = ctrl_ctx.get_discrete_state(group)
-        if s.GetAtIndex(ctl.FALL) != 0.0:
-            reason[0] = "fall"
-            return EventStatus.ReachedTermination(diagram, "fell")
-        com_x = s.GetAtIndex(ctl.COM_X)
-        if com_x >= target:
-            reason[0] = "distance"
-            return EventStatus.ReachedTermination(diagram, "distance reached")
-        if progress is not None and context.get_time() >= next_report[0]:
-            next_report[0] += 0.25
-            progress(context.get_time(), com_x - com_x0)
-        return EventStatus.Succeeded()
+        def monitor(context):
+            if context.get_time() >= next_report[0]:
+                next_report[0] += 0.25
+                progress(context.get_time(), ctrl_ctx.get_discrete_state(group).GetAtIndex(ctl.COM_X) - com_x0)
+            return EventStatus.Succeeded()
 
-    simulator.set_monitor(monitor)
+        simulator.set_monitor(monitor)
     simulator.Initialize()
     wall0 = time.perf_counter()
     try:
         simulator.AdvanceTo(config.sim.max_time_s)
+        s = ctrl_ctx.get_discrete_state(group)
+        reason = "fall" if s.GetAtIndex(ctl.FALL) != 0.0 else ("distance" if s.GetAtIndex(ctl.DONE) else "time limit")
     except RuntimeError as exc:  # a diverging contact solve: the episode is a fall, not a crash
-        reason[0] = f"simulation failed: {exc}".splitlines()[0]
+        reason = f"simulation failed: {exc}".splitlines()[0]
     wall = time.perf_counter() - wall0
-    return parts, simulator, reason[0], wall
+    return parts, simulator, reason, wall
 
 
 def run_episode(
@@ -146,28 +144,30 @@ def run_episode(
     record_trajectory: bool = False,
     progress: Callable[[float, float], None] | None = None,
 ) -> EpisodeResult:
-    """Walk one episode and summarise it (see EpisodeResult)."""
+    """Walk one episode and summarise it (see EpisodeResult).
+
+    The episode ends at the control update that detects a fall or the distance walked; its duration,
+    distance and work are those of the plant state that update read (see controller "Timing").
+    """
     config = config or EpisodeConfig()
-    parts, simulator, reason, wall = simulate(config, meshcat=meshcat, progress=progress)
+    parts, simulator, reason, wall = simulate(config, meshcat=meshcat, progress=progress, record=record_trajectory)
     context = simulator.get_context()
-    t_end = context.get_time()
-    ctrl_state = parts.controller.GetMyContextFromRoot(context).get_discrete_state(parts.controller.state_group)
-    s = ctrl_state.value().copy()
+    ctrl_ctx = parts.controller.GetMyContextFromRoot(context)
+    s = ctrl_ctx.get_discrete_state(parts.controller.state_group).value().copy()
+    t_end = float(s[ctl.STATE_TIME])
     fall_code = int(s[ctl.FALL])
     fell = reason != "distance" and reason != "time limit"
     fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
 
-    plant_ctx = parts.plant.GetMyContextFromRoot(context)
     q0, _, _, _ = initial_state(config)
-    q_end = parts.plant.GetPositions(plant_ctx)
-    distance = center_of_mass(q_end)[0] - center_of_mass(q0)[0]
+    distance = float(s[ctl.COM_X]) - center_of_mass(q0)[0]
 
     positive = {n: float(s[ctl.POSITIVE_WORK + i]) for i, n in enumerate(JOINT_NAMES)}
     positive["total"] = float(sum(s[ctl.POSITIVE_WORK : ctl.POSITIVE_WORK + 6]))
     signed = {n: float(s[ctl.SIGNED_WORK + i]) for i, n in enumerate(JOINT_NAMES)}
     signed["total"] = float(sum(s[ctl.SIGNED_WORK : ctl.SIGNED_WORK + 6]))
 
-    steps = extract_steps(parts, context)
+    steps = step_records(parts.controller.touchdowns(ctrl_ctx))
     if len(steps) >= 3:
         times = np.array([st.touchdown_time_s for st in steps])
         xs = np.array([st.com_x_m for st in steps])
@@ -203,34 +203,23 @@ def run_episode(
     )
 
 
-def extract_steps(parts: BipedDiagram, context) -> list[StepRecord]:
-    """Touchdowns from the controller log: the first sample after each increment of the step counter."""
-    log = parts.controller_log.FindLog(context)
-    data = log.data()
-    if data.shape[1] == 0:
-        return []
-    counts = data[ctl.STEP_COUNT]
-    idx = np.flatnonzero(np.diff(counts) > 0) + 1
-    states = parts.state_log.FindLog(context).data()
-    steps = []
-    for k, i in enumerate(idx):
-        x = states[:, i]
-        stance_right = data[ctl.STANCE_RIGHT, i] > 0.5
-        st, sw = (6, 3) if stance_right else (3, 6)
-        steps.append(
-            StepRecord(
-                index=k + 1,
-                touchdown_time_s=float(data[ctl.STEP_START, i]),
-                hip_angle_rad=float(x[st] - x[sw]),
-                hip_rate_radps=float(x[9 + st] - x[9 + sw]),
-                stance_leg="right" if stance_right else "left",
-                com_x_m=float(center_of_mass(x[:9])[0]),
-            )
+def step_records(touchdowns: np.ndarray) -> list[StepRecord]:
+    """StepRecords from the controller's touchdown rows (columns: controller.TOUCHDOWN_FIELDS)."""
+    return [
+        StepRecord(
+            index=k + 1,
+            touchdown_time_s=float(row[0]),
+            hip_angle_rad=float(row[1]),
+            hip_rate_radps=float(row[2]),
+            stance_leg="right" if row[3] > 0.5 else "left",
+            com_x_m=float(row[4]),
         )
-    return steps
+        for k, row in enumerate(touchdowns)
+    ]
 
 
 def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
+    """The logged signals (the diagram must have been built with record=True)."""
     states = parts.state_log.FindLog(context)
     acts = parts.actuation_log.FindLog(context)
     ctrl = parts.controller_log.FindLog(context)

@@ -27,6 +27,7 @@ TORSO_M = TABLE_I_LENGTHS_M["torso"]
 # Contact spheres: centre one radius above the sole, at the heel and at the toe.
 _SPHERE_Z = -SOLE_DEPTH_M + CONTACT_RADIUS_M
 _FOOT_COM = (0.03, -0.015)  # foot centre of mass in the ankle frame (m)
+_M_TORSO, _M_THIGH, _M_SHANK, _M_FOOT = (TABLE_I_MASSES_KG[k] for k in ("torso", "thigh", "shank", "foot"))
 
 
 class LegPoints(NamedTuple):
@@ -73,7 +74,7 @@ def center_of_mass(q) -> tuple[float, float]:
 
 def center_of_mass_from_legs(x: float, z: float, pitch: float, left: LegPoints, right: LegPoints) -> tuple[float, float]:
     """Centre of mass from the hip position, torso pitch and both legs' points (already computed)."""
-    mt, mth, msh, mft = (TABLE_I_MASSES_KG[k] for k in ("torso", "thigh", "shank", "foot"))
+    mt, mth, msh, mft = _M_TORSO, _M_THIGH, _M_SHANK, _M_FOOT
     sx = mt * (x - 0.5 * TORSO_M * math.sin(pitch))
     sz = mt * (z + 0.5 * TORSO_M * math.cos(pitch))
     for p in (left, right):

@@ -32,6 +32,8 @@ def test_swing_reference_endpoints_and_slope():
 @pytest.mark.parametrize("t, start, end, inside", [
     (0.25, 0.2, 0.5, True), (0.2, 0.2, 0.5, True), (0.5, 0.2, 0.5, False), (0.1, 0.2, 0.5, False),
     (0.3, 0.5, 0.5, False), (0.3, 0.6, 0.2, False),
+    # bounds on the control grid hold despite rounding in t - T_n
+    (0.851 - 0.651, 0.2, 0.5, True), (0.577 - 0.077, 0.2, 0.5, False),
 ])
 def test_window_membership(t, start, end, inside):
     assert cpg.in_torque_free_window(t, start, end) is inside

@@ -1,0 +1,85 @@
+"""The lean episode path: what the controller records and when it stops, checked against the logged walk."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+
+from drake_biped import controller as ctl
+from drake_biped.diagram import build_diagram, build_replay_diagram, initial_state
+from drake_biped.episode import run_episode
+from drake_biped.kinematics import center_of_mass
+from drake_biped.params import EpisodeConfig, SimulationParams
+
+
+def _config():
+    return EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=15.0))
+
+
+def test_replaying_the_logged_torques_retraces_the_closed_loop(short_walk):
+    """The plant alone, fed the closed loop's torques through a zero-order hold, walks the same walk:
+    the benchmark's plant-alone reference sees exactly the closed loop's contacts."""
+    T = short_walk.trajectory
+    config = _config()
+    diagram, plant = build_replay_diagram(config, T["time"], T["actuation"])
+    simulator = Simulator(diagram)
+    context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    q0, v0, _, _ = initial_state(config)
+    plant.SetPositions(context, q0)
+    plant.SetVelocities(context, v0)
+    for i in (len(T["time"]) // 2, len(T["time"]) - 1):
+        simulator.AdvanceTo(T["time"][i])
+        np.testing.assert_allclose(plant.GetPositions(context), T["positions"][i], rtol=0, atol=1e-9)
+
+
+def test_replay_rejects_a_malformed_log():
+    with pytest.raises(ValueError, match="torques"):
+        build_replay_diagram(_config(), np.arange(3) * 1e-3, np.zeros((3, 5)))
+
+
+def test_touchdown_records_are_the_logged_section_states(short_walk):
+    """Each recorded touchdown equals the logged plant state at its time: inter-leg angle and rate
+    (leading minus trailing thigh) and the centre of mass."""
+    T = short_walk.trajectory
+    assert len(short_walk.steps) >= 3
+    for step in short_walk.steps:
+        i = int(np.flatnonzero(np.isclose(T["time"], step.touchdown_time_s, rtol=0, atol=1e-9))[0])
+        st, sw = (6, 3) if step.stance_leg == "right" else (3, 6)
+        assert step.hip_angle_rad == pytest.approx(T["positions"][i, st] - T["positions"][i, sw], abs=1e-12)
+        assert step.hip_rate_radps == pytest.approx(T["velocities"][i, st] - T["velocities"][i, sw], abs=1e-9)
+        assert step.com_x_m == pytest.approx(center_of_mass(T["positions"][i])[0], abs=1e-12)
+        assert T["stance_right"][i] == (1.0 if step.stance_leg == "right" else 0.0)
+
+
+def test_episode_ends_at_the_update_that_walks_the_distance(short_walk):
+    """The controller stops the run at the first control update with the centre of mass past the
+    target: the distance overshoots by at most one control period of walking."""
+    dt = _config().sim.control_period_s
+    assert 3.0 <= short_walk.distance_m < 3.0 + 2.0 * dt  # well under 2 m/s
+    T = short_walk.trajectory
+    com = np.array([center_of_mass(q)[0] for q in T["positions"][-3:]]) - center_of_mass(T["positions"][0])[0]
+    assert com[-2] < 3.0  # one update earlier it had not arrived
+
+
+def test_loggers_do_not_change_the_walk(short_walk):
+    """The lean diagram (no loggers) and the recording one give the same episode to the last digit."""
+    lean = run_episode(_config())
+    assert lean.trajectory is None
+    assert lean.duration_s == short_walk.duration_s
+    assert lean.cost_of_transport == short_walk.cost_of_transport
+    assert [s.touchdown_time_s for s in lean.steps] == [s.touchdown_time_s for s in short_walk.steps]
+
+
+def test_loggers_are_built_only_when_recording():
+    def names(record):
+        return {s.get_name() for s in build_diagram(_config(), record=record).diagram.GetSystems()}
+
+    logs = {"state_log", "controller_log", "actuation_log"}
+    assert not logs & names(False)
+    assert logs <= names(True)
+
+
+def test_touchdown_capacity_covers_the_longest_episode():
+    config = _config()
+    need = config.sim.max_time_s / config.gait.touchdown_min_step_s
+    assert ctl.touchdown_capacity(config) >= need
+    assert ctl.touchdown_capacity(config) <= ctl.MAX_TOUCHDOWNS
