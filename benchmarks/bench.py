@@ -28,9 +28,12 @@ import time
 from pathlib import Path
 
 import numpy as np
+from pydrake.systems.framework import LeafSystem
 
+from drake_biped.controller import N_STATE, CpgWalkingController
 from drake_biped.diagram import build_replay_diagram, initial_state
 from drake_biped.episode import run_episode
+from drake_biped.kinematics import center_of_mass
 from drake_biped.parallel import dask_client, episode_task, map_ordered, peak_rss_mb
 from drake_biped.params import EpisodeConfig, SimulationParams, TorqueFreeWindow
 from drake_biped.versions import versions
@@ -68,16 +71,40 @@ def time_build(config: EpisodeConfig, repeats: int) -> list[float]:
     return out
 
 
-def replay(config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, duration: float) -> tuple[float, np.ndarray]:
-    """Wall time of the plant alone over `duration`, and its final positions."""
+class EmptyUpdate(LeafSystem):
+    """A Python system with a periodic discrete update that does nothing: the cost of the call itself."""
+
+    def __init__(self, period: float, io: bool = False):
+        super().__init__()
+        self._input = self.DeclareVectorInputPort("plant_state", 18)
+        self._torques = self.DeclareDiscreteState(6)
+        self._state = self.DeclareDiscreteState(N_STATE)
+        self.DeclareStateOutputPort("actuation", self._torques)
+        self._io = io
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+
+    def _update(self, context, discrete_state):
+        if self._io:  # the controller's input and output traffic, with no computation
+            self._input.Eval(context)
+            s = context.get_discrete_state(self._state).value().copy()
+            discrete_state.set_value(self._torques, s[:6])
+            discrete_state.set_value(self._state, s)
+
+
+def replay(config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, duration: float,
+           observer: LeafSystem | None = None) -> tuple[float, np.ndarray]:
+    """Wall time of the plant alone (plus an observer, if given) over `duration`, and its final positions."""
     from pydrake.systems.analysis import Simulator
 
-    diagram, plant = build_replay_diagram(config, times, torques)
+    diagram, plant = build_replay_diagram(config, times, torques, observer)
     simulator = Simulator(diagram)
-    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    root = simulator.get_mutable_context()
+    plant_context = plant.GetMyMutableContextFromRoot(root)
     q0, v0, _, _ = initial_state(config)
     plant.SetPositions(plant_context, q0)
     plant.SetVelocities(plant_context, v0)
+    if isinstance(observer, CpgWalkingController):
+        observer.set_initial_state(observer.GetMyMutableContextFromRoot(root), q0[3:], center_of_mass(q0)[0])
     simulator.Initialize()
     t = time.perf_counter()
     simulator.AdvanceTo(duration)
@@ -96,8 +123,9 @@ def real_time_factors(steps: list[float], distance: float, repeats: int) -> dict
         for h in steps:
             ref = logged[h]
             cfg = config_at(h, distance)
-            wall, q_end = replay(cfg, ref.trajectory["time"], ref.trajectory["actuation"], ref.duration_s)
-            samples[h]["plant"].append(ref.duration_s / wall)
+            end = float(ref.trajectory["time"][-1])  # the last logged state
+            wall, q_end = replay(cfg, ref.trajectory["time"], ref.trajectory["actuation"], end)
+            samples[h]["plant"].append(end / wall)
             samples[h]["replay_error_m"] = float(np.max(np.abs(q_end[:2] - ref.trajectory["positions"][-1][:2])))
             t = time.perf_counter()
             r = run_episode(cfg)
@@ -125,6 +153,49 @@ def real_time_factors(steps: list[float], distance: float, repeats: int) -> dict
     return {"distance_m": distance, "repeats": repeats, "rows": rows}
 
 
+def python_floor(distance: float, repeats: int) -> dict:
+    """At 1 ms: the plant alone, plus an empty Python update, plus one that only moves the controller's
+    inputs and outputs, plus the real controller computing alongside (its torques unused): microseconds
+    of wall time per simulated millisecond, medians of `repeats` interleaved rounds."""
+    config = config_at(1e-3, distance)
+    ref = run_episode(config, record_trajectory=True)
+    times, torques = ref.trajectory["time"], ref.trajectory["actuation"]
+    duration = float(times[-1])
+    _, stance_right, liftoff = initial_state(config)[1:]
+    variants = {
+        "plant alone": lambda: None,
+        "+ empty Python update": lambda: EmptyUpdate(1e-3),
+        "+ the controller's I/O only": lambda: EmptyUpdate(1e-3, io=True),
+        "+ the controller": lambda: CpgWalkingController(config, stance_right, liftoff),
+    }
+    samples: dict[str, list[float]] = {name: [] for name in variants}
+    for _ in range(repeats):
+        for name, make in variants.items():
+            wall, _ = replay(config, times, torques, duration, make())
+            samples[name].append(wall / duration * 1e3)  # us per simulated ms
+    rows = [{"variant": name, "us_per_ms": statistics.median(v), "samples": v} for name, v in samples.items()]
+    base = rows[0]["us_per_ms"]
+    for r in rows:
+        r["ratio_to_plant"] = base / r["us_per_ms"]
+    print("  " + ", ".join(f"{r['variant']}: {r['us_per_ms']:.0f} us/ms" for r in rows))
+    return {"distance_m": distance, "simulated_s": duration, "repeats": repeats, "rows": rows}
+
+
+def contact_approximations(distance: float) -> list[dict]:
+    """The closed loop under each of Drake's discrete contact approximations, with and without a window."""
+    rows = []
+    for approx in SimulationParams.CONTACT_APPROXIMATIONS:
+        for window in (None, (0.2, 0.5)):
+            base = config_at(1e-3, distance, window)
+            r = run_episode(base.replace(sim=SimulationParams(distance_m=distance, contact_approximation=approx)))
+            rows.append({"approximation": approx, "window": window, "walked": not r.fell,
+                         "distance_m": r.distance_m, "cost_of_transport": r.cost_of_transport,
+                         "real_time_factor": r.real_time_factor})
+            print(f"  {approx} window={window}: {r.distance_m:.2f} m, C_mt {r.cost_of_transport}, "
+                  f"{r.real_time_factor:.2f}x")
+    return rows
+
+
 def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> list[dict]:
     configs = [config_at(1e-3, distance, DASK_WINDOWS[i % len(DASK_WINDOWS)]).to_dict() for i in range(n_episodes)]
     out = []
@@ -139,6 +210,7 @@ def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> lis
         out.append({
             "workers": n,
             "episodes": n_episodes,
+            "distance_m": distance,
             "cluster_start_s": started,
             "wall_s": wall,
             "episodes_per_min": 60.0 * n_episodes / wall,
@@ -176,8 +248,24 @@ def markdown(record: dict) -> str:
     lines += ["", "Plant alone: the same plant replaying the closed loop's logged torques (largest final position "
               "difference from the closed loop: "
               + ", ".join(f"{r['replay_max_position_error_m']:.1e} m" for r in record["rtf"]["rows"]) + ")."]
+    if record.get("floor"):
+        f = record["floor"]
+        lines += ["", f"## Where the closed loop's time goes, 1 ms ({f['simulated_s']:.1f} simulated s, "
+                  f"median of {f['repeats']})", "",
+                  "Each variant replays the same logged torques; the systems added compute alongside the plant "
+                  "without driving it.", "",
+                  "| variant | wall µs per simulated ms | plant alone / variant |", "|---|---|---|"]
+        for r in f["rows"]:
+            lines.append(f"| {r['variant']} | {r['us_per_ms']:.0f} | {r['ratio_to_plant']:.2f} |")
+    if record.get("contact"):
+        lines += ["", f"## Contact approximation, 1 ms closed loop, {record['rtf']['distance_m']:g} m", "",
+                  "| approximation | window | walked | distance | C_mt | real-time factor |", "|---|---|---|---|---|---|"]
+        for r in record["contact"]:
+            cmt = "—" if r["cost_of_transport"] is None else f"{r['cost_of_transport']:.4f}"
+            lines.append(f"| {r['approximation']} | {r['window'] or 'none'} | {'yes' if r['walked'] else 'no'} | "
+                         f"{r['distance_m']:.2f} m | {cmt} | {r['real_time_factor']:.2f}× |")
     if record.get("dask"):
-        lines += ["", "## Dask LocalCluster, 1 ms, 10 m episodes with assorted windows", "",
+        lines += ["", f"## Dask LocalCluster, 1 ms, {record['dask'][0]['distance_m']:g} m episodes with assorted windows", "",
                   "| workers | episodes | wall | episodes/min | speed-up | cluster start | peak memory/worker |",
                   "|---|---|---|---|---|---|---|"]
         base = record["dask"][0]["episodes_per_min"]
@@ -228,6 +316,10 @@ def main(argv: list[str] | None = None) -> int:
     }
     print("real-time factors")
     record["rtf"] = real_time_factors(steps, distance, repeats)
+    print("where the time goes (1 ms)")
+    record["floor"] = python_floor(distance, max(repeats, 3))
+    print("contact approximations")
+    record["contact"] = contact_approximations(distance)
     if n_dask:
         print("dask")
         record["dask"] = dask_runs([1, 2], n_dask, 10.0 if not args.quick else distance)

@@ -90,7 +90,9 @@ def build_diagram(
     summary needs (the controller's own state: work integrals, touchdowns, fall flag).
     """
     builder = DiagramBuilder()
-    handles = add_biped(builder, config.ground, config.sim.time_step_s)
+    handles = add_biped(
+        builder, config.ground, config.sim.time_step_s, contact_approximation=config.sim.contact_approximation
+    )
     plant = handles.plant
     _, _, stance_right, liftoff = initial_state(config)
     controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, stance_right, liftoff))
@@ -121,25 +123,31 @@ def build_diagram(
 
 
 def build_replay_diagram(
-    config: EpisodeConfig, times: np.ndarray, torques: np.ndarray
+    config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, observer: LeafSystem | None = None
 ) -> tuple[Diagram, MultibodyPlant]:
     """The plant alone, driven by a zero-order hold of logged torques (no controller, no Python).
 
     times (n,) and torques (n, 6) are an actuation log sampled at the control period: torque k acts over
     [times[k], times[k] + period). Replayed from the same initial state at the same time step, it reproduces
     the closed-loop trajectory, so the plant sees exactly the closed loop's contacts: the reference against
-    which the controller's cost is measured.
+    which the controller's cost is measured. An `observer` (a system with one 18-vector input) is fed the
+    plant state and drives nothing: it times a controller's computation without letting it act.
     """
     times = np.asarray(times, dtype=float)
     torques = np.asarray(torques, dtype=float)
     if times.ndim != 1 or torques.shape != (times.size, 6) or times.size < 1:
         raise ValueError(f"expected times (n,) and torques (n, 6), got {times.shape} and {torques.shape}")
     builder = DiagramBuilder()
-    plant = add_biped(builder, config.ground, config.sim.time_step_s).plant
+    plant = add_biped(
+        builder, config.ground, config.sim.time_step_s, contact_approximation=config.sim.contact_approximation
+    ).plant
     breaks = np.append(times, times[-1] + config.sim.control_period_s)
     hold = PiecewisePolynomial.ZeroOrderHold(breaks, np.vstack([torques, torques[-1:]]).T)
     source = builder.AddNamedSystem("logged_torques", TrajectorySource(hold))
     builder.Connect(source.get_output_port(), plant.get_actuation_input_port())
+    if observer is not None:
+        builder.AddSystem(observer)
+        builder.Connect(plant.get_state_output_port(), observer.get_input_port(0))
     diagram = builder.Build()
     diagram.set_name("drake_biped_replay")
     return diagram, plant

@@ -57,14 +57,17 @@ def add_biped(
     time_step_s: float,
     model_url: str = MODEL_URL,
     package_xml: Path = PACKAGE_XML,
+    contact_approximation: str = "sap",
 ) -> PlantHandles:
     """Add the biped and the ground to `builder` and finalize the plant.
 
-    Contact: SAP with point contact (the heel/toe spheres against the ground half-space(s)).
+    Contact: point contact (the heel/toe spheres against the ground half-space(s)), solved by the discrete
+    contact approximation given (SAP by default). Output ports are sampled (see controller "Timing").
     """
     config = MultibodyPlantConfig(
         time_step=time_step_s,
-        discrete_contact_approximation="sap",
+        use_sampled_output_ports=True,
+        discrete_contact_approximation=contact_approximation,
         contact_model="point",
         penetration_allowance=1e-3,
     )

@@ -277,6 +277,9 @@ class SimulationParams(_Validated):
     # Fall: hip below this height above the ground, or torso pitch beyond this angle.
     fall_hip_height_m: float = 0.35
     fall_pitch_rad: float = 1.0
+    # Drake's discrete contact approximation. SAP was chosen by measurement (benchmarks/bench.py):
+    # "similar" and "lagged" walk but are no faster, and the gait falls within half a metre under "tamsi".
+    contact_approximation: str = "sap"
 
     _RANGES = {
         "time_step_s": (1e-5, 0.02),
@@ -287,8 +290,15 @@ class SimulationParams(_Validated):
         "fall_pitch_rad": (0.05, math.pi),
     }
 
+    CONTACT_APPROXIMATIONS = ("sap", "similar", "lagged", "tamsi")
+
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.contact_approximation not in self.CONTACT_APPROXIMATIONS:
+            raise ParameterError(
+                f"SimulationParams.contact_approximation = {self.contact_approximation!r} is not one of "
+                f"{list(self.CONTACT_APPROXIMATIONS)}"
+            )
         ratio = self.control_period_s / self.time_step_s
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
             raise ParameterError(
