@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 OUT ?= out
 
-.PHONY: setup walk test test-fast lint format window-map clean
+.PHONY: setup walk test test-fast lint format window-map bench clean
 
 setup: $(VENV)/.installed
 
@@ -31,6 +31,11 @@ format: setup
 
 window-map: setup
 	$(VENV)/bin/drake-biped window-map --out $(OUT)/window-map
+
+# Speed and time-step benchmarks (about 8 minutes on 2 cores): Markdown + JSON in out/bench, out/time-step-study.
+bench: setup
+	$(PY) benchmarks/bench.py --out $(OUT)/bench
+	$(PY) benchmarks/time_step_study.py --out $(OUT)/time-step-study
 
 clean:
 	rm -rf $(OUT) .pytest_cache
