@@ -81,17 +81,13 @@ class CpgWalkingController(LeafSystem):
 
     def __init__(self, config: EpisodeConfig, initial_stance_right: bool, initial_liftoff_angle: float):
         super().__init__()
-        self._config = config
-        self._cpg = config.cpg
-        self._gait = config.gait
+        # Structure: fixed for the life of the system.
+        self._structure = self.structure_key(config)
         self._ground = config.ground
-        self._window = config.window
         self._dt = config.sim.control_period_s
         self._state_lag = config.sim.time_step_s  # see "Timing" above
-        self._amplitude = config.cpg.swing_amplitude_rad
-        self._fall_height = config.sim.fall_hip_height_m
-        self._fall_pitch = config.sim.fall_pitch_rad
         self._capacity = touchdown_capacity(config)
+        self.configure(config)
 
         self._plant_state = self.DeclareVectorInputPort("plant_state", 18)
         initial = np.zeros(N_STATE)
@@ -105,17 +101,51 @@ class CpgWalkingController(LeafSystem):
         self.DeclareStateOutputPort("controller_state", self._state_group)
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
 
+    @staticmethod
+    def structure_key(config: EpisodeConfig) -> tuple:
+        """What the system's ports, state sizes and update period are built from."""
+        sim = config.sim
+        return (config.ground, sim.time_step_s, sim.control_period_s, sim.max_time_s, config.gait.touchdown_min_step_s)
+
+    def configure(self, config: EpisodeConfig) -> None:
+        """Take the per-episode numbers (CPG, gait, window, fall thresholds) of `config` for the next
+        simulation. Its structure (ground, time step, control period, touchdown capacity) must be the one
+        this system was built with. Call it between simulations, never during one."""
+        if self.structure_key(config) != self._structure:
+            raise ValueError("configure: this controller was built for another ground, time step, control "
+                             "period, time limit or minimum step time; build a new diagram")
+        self._config = config
+        self._cpg = config.cpg
+        self._gait = config.gait
+        self._window = config.window
+        self._amplitude = config.cpg.swing_amplitude_rad
+        self._fall_height = config.sim.fall_hip_height_m
+        self._fall_pitch = config.sim.fall_pitch_rad
+
     @property
     def state_group(self) -> int:
         return int(self._state_group)
 
-    def set_initial_state(self, context, joint_angles, com_x: float, distance_m: float = math.inf) -> None:
-        """Seed the work integrator's previous angles, the centre-of-mass x, and the distance to walk."""
+    def set_initial_state(
+        self,
+        context,
+        joint_angles,
+        com_x: float,
+        distance_m: float = math.inf,
+        stance_right: bool | None = None,
+        liftoff_angle: float | None = None,
+    ) -> None:
+        """Seed the work integrator's previous angles, the centre-of-mass x and the distance to walk, and
+        (when given) the first stance leg and the swing thigh's lift-off angle."""
         s = context.get_mutable_discrete_state(self._state_group)
         s.SetAtIndex(COM_X, com_x)
         s.SetAtIndex(TARGET_X, com_x + distance_m)
         for i in range(6):
             s.SetAtIndex(Q_PREV + i, float(joint_angles[i]))
+        if stance_right is not None:
+            s.SetAtIndex(STANCE_RIGHT, 1.0 if stance_right else 0.0)
+        if liftoff_angle is not None:
+            s.SetAtIndex(LIFTOFF_ANGLE, liftoff_angle)
 
     def touchdowns(self, context) -> np.ndarray:
         """The recorded touchdowns, one row each (columns: TOUCHDOWN_FIELDS)."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -16,6 +17,7 @@ from pydrake.systems.framework import EventStatus
 
 from analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg
 from drake_biped import controller as ctl
+from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
 from drake_biped.model import JOINT_NAMES
@@ -92,29 +94,85 @@ def _finite_or_none(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
+class DiagramCache:
+    """Built diagrams and their simulators, kept for reuse by episodes of the same structure.
+
+    Only the numbers of an episode (CPG, gait, window, initial conditions, distance) change between the
+    episodes of a learning run or a grid search; rebuilding the diagram for each would cost a few ms and,
+    with pydrake 1.51, leak ~0.4 MB per build (RobotLocomotion/drake#24529). An entry is keyed by what the
+    diagram is built from: the ground, time step, control period, time limit, minimum step time, contact
+    approximation, push and recording. At most `size` entries are kept (least recently used goes first).
+    """
+
+    def __init__(self, size: int = 4):
+        self._size = size
+        self._entries: OrderedDict[tuple, tuple[BipedDiagram, Simulator]] = OrderedDict()
+
+    @staticmethod
+    def key(config: EpisodeConfig, record: bool, log_period_s: float | None) -> tuple:
+        return (
+            CpgWalkingController.structure_key(config),
+            config.sim.contact_approximation,
+            config.push,
+            record,
+            log_period_s,
+        )
+
+    def get(self, config: EpisodeConfig, record: bool, log_period_s: float | None) -> tuple[BipedDiagram, Simulator]:
+        key = self.key(config, record, log_period_s)
+        if key in self._entries:
+            self._entries.move_to_end(key)
+            return self._entries[key]
+        parts = build_diagram(config, record=record, log_period_s=log_period_s)
+        entry = (parts, Simulator(parts.diagram))
+        self._entries[key] = entry
+        while len(self._entries) > self._size:
+            self._entries.popitem(last=False)
+        return entry
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+
+_CACHE = DiagramCache()
+
+
 def simulate(
     config: EpisodeConfig,
     meshcat=None,
     progress: Callable[[float, float], None] | None = None,
     record: bool = False,
     log_period_s: float | None = None,
+    cache: DiagramCache | None = _CACHE,
 ) -> tuple[BipedDiagram, Simulator, str, float]:
-    """Build and run the diagram; return it, the simulator, the termination reason and the wall time.
+    """Run one episode; return the diagram, the simulator, the termination reason and the wall time.
 
-    The controller ends the episode itself (a fall, or the distance walked); the Simulator runs no Python
-    between control updates unless `progress` asks for reports (every 0.25 simulated s).
-    Reasons: "distance", "fall", "time limit", or "simulation failed: ..." (a diverging contact solve).
+    The diagram comes from `cache` when one of the same structure was built before (never with Meshcat;
+    cache=None always builds a new one); its context is reset to the defaults and this episode's numbers
+    and initial state. The controller ends the episode itself (a fall, or the distance walked); the
+    Simulator runs no Python between control updates unless `progress` asks for reports (every 0.25
+    simulated s). Reasons: "distance", "fall", "time limit", or "simulation failed: ..." (a diverging
+    contact solve).
     """
-    parts = build_diagram(config, meshcat=meshcat, record=record, log_period_s=log_period_s)
-    simulator = Simulator(parts.diagram)
+    if meshcat is None and cache is not None:
+        parts, simulator = cache.get(config, record, log_period_s)
+    else:
+        parts = build_diagram(config, meshcat=meshcat, record=record, log_period_s=log_period_s)
+        simulator = Simulator(parts.diagram)
     root = simulator.get_mutable_context()
+    parts.diagram.SetDefaultContext(root)
+    root.SetTime(0.0)
+    for log in (parts.state_log, parts.controller_log, parts.actuation_log):
+        if log is not None:
+            log.FindMutableLog(root).Clear()
+    parts.controller.configure(config)
     plant_ctx = parts.plant.GetMyMutableContextFromRoot(root)
-    q0, v0, _, _ = initial_state(config)
+    q0, v0, stance_right, liftoff = initial_state(config)
     parts.plant.SetPositions(plant_ctx, q0)
     parts.plant.SetVelocities(plant_ctx, v0)
     com_x0 = center_of_mass(q0)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
-    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m)
+    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff)
     group = parts.controller.state_group
     if progress is not None:
         next_report = [0.0]
@@ -126,6 +184,8 @@ def simulate(
             return EventStatus.Succeeded()
 
         simulator.set_monitor(monitor)
+    else:
+        simulator.clear_monitor()
     simulator.Initialize()
     wall0 = time.perf_counter()
     try:
@@ -143,14 +203,17 @@ def run_episode(
     meshcat=None,
     record_trajectory: bool = False,
     progress: Callable[[float, float], None] | None = None,
+    cache: DiagramCache | None = _CACHE,
 ) -> EpisodeResult:
-    """Walk one episode and summarise it (see EpisodeResult).
+    """Walk one episode and summarise it (see EpisodeResult). `cache`: see simulate().
 
     The episode ends at the control update that detects a fall or the distance walked; its duration,
     distance and work are those of the plant state that update read (see controller "Timing").
     """
     config = config or EpisodeConfig()
-    parts, simulator, reason, wall = simulate(config, meshcat=meshcat, progress=progress, record=record_trajectory)
+    parts, simulator, reason, wall = simulate(
+        config, meshcat=meshcat, progress=progress, record=record_trajectory, cache=cache
+    )
     context = simulator.get_context()
     ctrl_ctx = parts.controller.GetMyContextFromRoot(context)
     s = ctrl_ctx.get_discrete_state(parts.controller.state_group).value().copy()

@@ -6,9 +6,9 @@ from pydrake.systems.analysis import Simulator
 
 from drake_biped import controller as ctl
 from drake_biped.diagram import build_diagram, build_replay_diagram, initial_state
-from drake_biped.episode import run_episode
+from drake_biped.episode import DiagramCache, run_episode
 from drake_biped.kinematics import center_of_mass
-from drake_biped.params import EpisodeConfig, SimulationParams
+from drake_biped.params import EpisodeConfig, Ground, InitialConditions, SimulationParams, TorqueFreeWindow
 
 
 def _config():
@@ -83,3 +83,38 @@ def test_touchdown_capacity_covers_the_longest_episode():
     need = config.sim.max_time_s / config.gait.touchdown_min_step_s
     assert ctl.touchdown_capacity(config) >= need
     assert ctl.touchdown_capacity(config) <= ctl.MAX_TOUCHDOWNS
+
+
+def test_a_reused_diagram_gives_the_numbers_of_a_fresh_one():
+    """Episodes share a built diagram when their structure matches; whatever ran before, an episode's
+    numbers are those of a diagram built for it alone."""
+    a = EpisodeConfig(sim=SimulationParams(distance_m=1.0, max_time_s=15.0))
+    b = a.replace(window=TorqueFreeWindow(0.2, 0.5), initial=InitialConditions(hip_angle_rad=0.3, speed_mps=0.4))
+    cache = DiagramCache()
+    first = run_episode(a, cache=cache)
+    other = run_episode(b, cache=cache)
+    again = run_episode(a, cache=cache)
+    fresh = run_episode(a, cache=None)
+    assert len(cache) == 1
+    assert other.cost_of_transport != first.cost_of_transport
+    for r in (again, fresh):
+        assert r.to_dict() | {"wall_time_s": 0, "real_time_factor": 0} == first.to_dict() | {
+            "wall_time_s": 0, "real_time_factor": 0}
+
+
+def test_cache_builds_a_new_diagram_for_a_new_structure():
+    cache = DiagramCache(size=2)
+    base = EpisodeConfig(sim=SimulationParams(distance_m=0.2, max_time_s=5.0))
+    run_episode(base, cache=cache)
+    run_episode(base.replace(sim=SimulationParams(distance_m=0.2, max_time_s=5.0, time_step_s=5e-4,
+                                                  control_period_s=5e-4)), cache=cache)
+    run_episode(base.replace(ground=Ground(slope_rad=0.01)), cache=cache)
+    assert len(cache) == 2  # the least recently used one was dropped
+
+
+def test_controller_refuses_a_config_of_another_structure():
+    config = _config()
+    c = ctl.CpgWalkingController(config, True, 0.0)
+    c.configure(config.replace(window=TorqueFreeWindow(0.1, 0.3)))  # numbers only: fine
+    with pytest.raises(ValueError, match="another ground"):
+        c.configure(config.replace(ground=Ground(slope_rad=0.02)))
