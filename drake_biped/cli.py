@@ -147,6 +147,7 @@ def cmd_walk(args: argparse.Namespace) -> int:
     bar, update = _progress_bar(config.sim.distance_m, "walk")
     try:
         result = run_episode(config, meshcat=meshcat, record_trajectory=True, progress=update)
+        update(result.duration_s, result.distance_m)  # the last report came up to 0.25 s before the end
     finally:
         bar.close()
     result.to_json(out / "result.json")
