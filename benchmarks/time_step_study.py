@@ -147,9 +147,10 @@ def figure(rec: dict, path: Path) -> None:
     ax.axhspan(-band, band, color="0.9", zorder=0)
     ax.set_xscale("log")
     ax.set_xticks(steps_ms, [f"{x:g}" for x in steps_ms])
+    ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
     ax.set_xlabel("time step (ms)")
     ax.set_ylabel(f"C_mt change from {rec['reference_s'] * 1e3:g} ms (%)")
-    ax.set_title("Time-step study (× : fell; grey: ±2 %)")
+    ax.set_title("Time-step study (×: a fall; grey: ±2 %)")
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -164,7 +165,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--distance", type=float, default=10.0)
     p.add_argument("--workers", type=int, default=None)
     p.add_argument("--scheduler", default=None)
+    p.add_argument("--replot", action="store_true", help="redraw the Markdown and figure from OUT's JSON")
     args = p.parse_args(argv)
+    if args.replot:
+        rec = json.loads((args.out / "time_step_study.json").read_text())
+        (args.out / "time_step_study.md").write_text(markdown(rec))
+        figure(rec, args.out / "time_step_study.png")
+        return 0
     try:
         steps = sorted(float(s) for s in args.steps.split(","))
     except ValueError:
