@@ -35,7 +35,7 @@ window-map: setup
 # Speed and time-step benchmarks (about 8 minutes on 2 cores): Markdown + JSON in out/bench, out/time-step-study.
 bench: setup
 	$(PY) benchmarks/bench.py --out $(OUT)/bench
-	$(PY) benchmarks/time_step_study.py --out $(OUT)/time-step-study
+	$(VENV)/bin/drake-biped time-step-study --out $(OUT)/time-step-study
 
 clean:
 	rm -rf $(OUT) .pytest_cache

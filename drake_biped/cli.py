@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -205,6 +205,27 @@ def cmd_gait_search(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_time_step_study(args: argparse.Namespace) -> int:
+    from drake_biped.time_step import replot, run_study
+
+    out = Path(args.out)
+    if args.replot:
+        if not (out / "time_step_study.json").is_file():
+            raise ParameterError(f"--replot: no time_step_study.json in {out}")
+        rec = replot(out)
+    else:
+        rec = run_study(out, args.steps, args.reference, args.distance, args.workers, args.scheduler)
+    print((out / "time_step_study.md").read_text())
+    chosen = rec["chosen_step_s"]
+    print(f"chosen step: {chosen * 1e3:g} ms" if chosen else "no step passes", f"; wrote {out}/")
+    return 0
+
+
+def _steps(text: str) -> list[float]:
+    parse = _number("positive")
+    return [parse(t) for t in text.split(",")]
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="drake-biped", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -236,6 +257,17 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--workers", type=_count, default=2, help="parallel processes (default 2)")
     search.add_argument("--out", required=True, help="output folder (rerun to resume)")
     search.set_defaults(func=cmd_gait_search)
+
+    ts = sub.add_parser("time-step-study", help="C_mt, speed and step period against the time step; the default")
+    ts.add_argument("--steps", type=_steps, default=[0.00025, 0.0005, 0.001, 0.002, 0.005],
+                    help="time steps (s), comma-separated (default 0.00025,0.0005,0.001,0.002,0.005)")
+    ts.add_argument("--reference", type=_number("positive"), default=0.0005, help="reference step (s), one of --steps")
+    ts.add_argument("--distance", type=_number("positive"), default=10.0, help="walk this far (m); default 10")
+    ts.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
+    ts.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
+    ts.add_argument("--out", required=True, help="output folder")
+    ts.set_defaults(func=cmd_time_step_study)
     return parser
 
 

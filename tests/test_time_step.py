@@ -1,0 +1,52 @@
+"""The time-step study's rule for choosing the default step, on results whose answer is known."""
+
+import pytest
+
+from drake_biped.cli import main
+from drake_biped.time_step import choose_step
+
+STEPS = [0.00025, 0.0005, 0.001, 0.002, 0.005]
+
+
+def _rows(table):
+    """table: {window: {step: C_mt or None for a fall}}"""
+    rows = []
+    for window, by_step in table.items():
+        for h, cmt in by_step.items():
+            rows.append({"time_step_s": h, "window": window, "walked": cmt is not None, "cost_of_transport": cmt})
+    return rows
+
+
+def test_largest_passing_step_above_the_reference_is_chosen():
+    rows = _rows({
+        None: {0.00025: 1.00, 0.0005: 1.00, 0.001: 1.015, 0.002: 1.01, 0.005: None},
+        (0.2, 0.5): {0.00025: 0.70, 0.0005: 0.70, 0.001: 0.713, 0.002: 0.75, 0.005: None},
+    })
+    out = choose_step(rows, STEPS, 0.0005, 0.02)
+    assert out["chosen_step_s"] == 0.001  # 2 ms moves the window's C_mt by +7 %
+    assert out["passing_steps"] == [0.00025, 0.0005, 0.001]
+    dev = {(r["time_step_s"], r["window"]): r["cmt_deviation"] for r in rows}
+    assert dev[(0.001, (0.2, 0.5))] == pytest.approx(0.013 / 0.70)
+    assert dev[(0.005, None)] is None
+
+
+def test_a_walk_that_falls_at_the_reference_is_not_judged_but_a_fall_elsewhere_fails_the_step():
+    rows = _rows({
+        None: {0.00025: 1.0, 0.0005: 1.0, 0.001: 1.0, 0.002: None, 0.005: None},
+        (0.2, 0.7): {0.00025: None, 0.0005: None, 0.001: 0.8, 0.002: None, 0.005: None},
+    })
+    out = choose_step(rows, STEPS, 0.0005, 0.02)
+    assert out["not_judged"] == [[0.2, 0.7]]
+    assert out["chosen_step_s"] == 0.001  # the no-window walk falls at 2 ms
+
+
+def test_a_failing_step_stops_the_choice_even_if_a_coarser_one_passes():
+    rows = _rows({None: {0.00025: 1.0, 0.0005: 1.0, 0.001: 1.05, 0.002: 1.0, 0.005: 1.0}})
+    assert choose_step(rows, STEPS, 0.0005, 0.02)["chosen_step_s"] == 0.0005
+
+
+def test_reference_outside_the_steps_is_refused(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["time-step-study", "--out", str(tmp_path), "--steps", "0.001,0.002", "--reference", "0.0005"])
+    assert exc.value.code == 2
+    assert "--reference" in capsys.readouterr().err
