@@ -226,6 +226,27 @@ def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> lis
     return out
 
 
+def learning_mix(n_episodes: int, workers: int, seed: int = 0) -> dict:
+    """Episodes as a learning run starts them: windows drawn from GARB's initial policy (mean (0.5, 0.5) s,
+    variance 0.04 s^2 per component, negative times clipped to 0), 10 m or a fall, on `workers` workers."""
+    rng = np.random.default_rng(seed)
+    windows = np.clip(rng.normal(0.5, 0.2, size=(n_episodes, 2)), 0.0, None)
+    configs = [config_at(1e-3, 10.0, (float(a), float(b))).to_dict() for a, b in windows]
+    with dask_client(workers=workers) as client:
+        client.submit(sum, [1, 2]).result()
+        t0 = time.perf_counter()
+        results = map_ordered(client, episode_task, configs)
+        wall = time.perf_counter() - t0
+    falls = sum(r["fell"] for r in results)
+    per_min = 60.0 * n_episodes / wall
+    out = {"episodes": n_episodes, "workers": workers, "seed": seed, "wall_s": wall, "episodes_per_min": per_min,
+           "falls": falls, "simulated_s": sum(r["duration_s"] for r in results),
+           "experiment_1_minutes": 2500 / per_min}
+    print(f"  learning mix: {n_episodes} episodes ({falls} falls) in {wall:.1f} s on {workers} workers = "
+          f"{per_min:.1f}/min; Experiment 1 (2500 episodes) ~ {out['experiment_1_minutes']:.0f} min")
+    return out
+
+
 def markdown(record: dict) -> str:
     lines = [
         "# drake-biped benchmarks",
@@ -274,6 +295,15 @@ def markdown(record: dict) -> str:
                 f"| {d['workers']} | {d['episodes']} | {d['wall_s']:.1f} s | {d['episodes_per_min']:.1f} | "
                 f"{d['episodes_per_min'] / base:.2f}× | {d['cluster_start_s']:.1f} s | {d['peak_rss_mb_per_worker']:.0f} MB |"
             )
+    if record.get("learning"):
+        m = record["learning"]
+        lines += ["", "## Experiment 1 estimate", "",
+                  f"{m['episodes']} episodes with windows drawn from GARB's initial policy (seed {m['seed']}; "
+                  f"{m['falls']} fell) on {m['workers']} Dask workers: {m['wall_s']:.1f} s, "
+                  f"**{m['episodes_per_min']:.1f} episodes/min**, so Experiment 1 (5 trials × 500 episodes) "
+                  f"≈ **{m['experiment_1_minutes']:.0f} min** at this mix. With every episode walking 10 m "
+                  f"(the Dask table's rate on 2 workers) it would take "
+                  f"≈ {2500 / record['dask'][-1]['episodes_per_min']:.0f} min." if record.get("dask") else ""]
     imp, build = record["import_s"], record["build_s"]
     lines += [
         "",
@@ -323,6 +353,8 @@ def main(argv: list[str] | None = None) -> int:
     if n_dask:
         print("dask")
         record["dask"] = dask_runs([1, 2], n_dask, 10.0 if not args.quick else distance)
+        print("learning mix")
+        record["learning"] = learning_mix(4 if args.quick else 24, 2)
     record["peak_rss_mb_main"] = peak_rss_mb()
     (args.out / "benchmarks.json").write_text(json.dumps(record, indent=2) + "\n")
     table = markdown(record)
