@@ -197,9 +197,11 @@ def contact_approximations(distance: float) -> list[dict]:
 
 
 def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> list[dict]:
+    """The same episodes on LocalClusters of each size, in the order 1, 2, 2, 1 (...), so that a drift in
+    machine speed affects every size alike; one row per size with the mean wall time of its runs."""
     configs = [config_at(1e-3, distance, DASK_WINDOWS[i % len(DASK_WINDOWS)]).to_dict() for i in range(n_episodes)]
-    out = []
-    for n in worker_counts:
+    runs: dict[int, list[dict]] = {n: [] for n in worker_counts}
+    for n in worker_counts + worker_counts[::-1]:
         t0 = time.perf_counter()
         with dask_client(workers=n) as client:
             started = time.perf_counter() - t0
@@ -207,22 +209,28 @@ def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> lis
             t1 = time.perf_counter()
             results = map_ordered(client, episode_task, configs)
             wall = time.perf_counter() - t1
+        runs[n].append({"wall_s": wall, "cluster_start_s": started, "results": results})
+        print(f"  dask {n} worker(s): {n_episodes} episodes in {wall:.1f} s ({60.0 * n_episodes / wall:.1f}/min)")
+    out = []
+    for n, rs in runs.items():
+        wall = statistics.mean(r["wall_s"] for r in rs)
+        results = [x for r in rs for x in r["results"]]
         out.append({
             "workers": n,
             "episodes": n_episodes,
+            "runs": len(rs),
             "distance_m": distance,
-            "cluster_start_s": started,
+            "cluster_start_s": statistics.mean(r["cluster_start_s"] for r in rs),
             "wall_s": wall,
+            "wall_s_samples": [r["wall_s"] for r in rs],
             "episodes_per_min": 60.0 * n_episodes / wall,
-            "peak_rss_mb_per_worker": max(r["worker_peak_rss_mb"] for r in results),
-            "simulated_s": sum(r["duration_s"] for r in results),
-            "cost_of_transport": [r["cost_of_transport"] for r in results],
+            "peak_rss_mb_per_worker": max(x["worker_peak_rss_mb"] for x in results),
+            "simulated_s": sum(x["duration_s"] for x in rs[0]["results"]),
+            "same_results_in_every_run": len({tuple(x["cost_of_transport"] for x in r["results"]) for r in rs}) == 1,
         })
-        print(f"  dask {n} worker(s): {n_episodes} episodes in {wall:.1f} s "
-              f"({out[-1]['episodes_per_min']:.1f}/min), peak {out[-1]['peak_rss_mb_per_worker']:.0f} MB/worker")
-    if len(out) == 2:
-        same = out[0]["cost_of_transport"] == out[1]["cost_of_transport"]
-        out[1]["same_results_as_first"] = same
+    costs = {tuple(x["cost_of_transport"] for x in rs[0]["results"]) for rs in runs.values()}
+    for row in out:
+        row["same_results_for_every_size"] = len(costs) == 1
     return out
 
 
@@ -287,6 +295,8 @@ def markdown(record: dict) -> str:
                          f"{r['distance_m']:.2f} m | {cmt} | {r['real_time_factor']:.2f}× |")
     if record.get("dask"):
         lines += ["", f"## Dask LocalCluster, 1 ms, {record['dask'][0]['distance_m']:g} m episodes with assorted windows", "",
+                  "Sizes run in the order 1, 2, 2, 1; wall = mean of the two runs of a size. "
+                  f"Same C_mt in every run and size: {record['dask'][0]['same_results_for_every_size']}.", "",
                   "| workers | episodes | wall | episodes/min | speed-up | cluster start | peak memory/worker |",
                   "|---|---|---|---|---|---|---|"]
         base = record["dask"][0]["episodes_per_min"]
