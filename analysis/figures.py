@@ -3,6 +3,7 @@ torque-free window map."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -148,3 +149,136 @@ def window_map_figure(rows: list[dict], baseline_cmt: float | None, path: str | 
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+# Table V of the paper (C_mt) and our measured rows.
+TABLE_V_PAPER = {"ASIMO": 1.60, "CPG without torque-free period": 0.58, "CPG with torque-free period": 0.29,
+                 "human": 0.05}
+
+
+def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
+    """Trailing moving average over up to n samples, ignoring NaNs (NaN where a window has none)."""
+    out = np.full(x.shape, np.nan)
+    for i in range(len(x)):
+        w = x[max(0, i - n + 1) : i + 1]
+        w = w[np.isfinite(w)]
+        if w.size:
+            out[i] = w.mean()
+    return out
+
+
+def _learning_arrays(record: dict) -> dict[str, np.ndarray]:
+    trials = record["trials"]
+    n = min(len(t["episodes"]) for t in trials)
+
+    def grid(key):
+        return np.array([[np.nan if e[key] is None else float(e[key]) for e in t["episodes"][:n]] for t in trials])
+
+    cmt = grid("cost_of_transport")
+    cmt[np.array([[e["fell"] for e in t["episodes"][:n]] for t in trials])] = np.nan  # falls: no C_mt
+    return {"episode": np.arange(1, n + 1), "reward": grid("reward"), "cmt": cmt, "t1": grid("t1"),
+            "t2": grid("t2"), "mean_t1": grid("mean_t1"), "mean_t2": grid("mean_t2")}
+
+
+def learning_figures(record: dict, out: str | Path) -> list[Path]:
+    """Fig. 4 (mean reward over trials, std bars), Fig. 5 (C_mt, moving average), Fig. 6 (t1, t2) and
+    Table V (Markdown), from a learning.json record. Episodes where every trial fell have no C_mt."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # nanmean of all-NaN columns: those NaNs are meant
+        return _learning_figures(record, Path(out))
+
+
+def _learning_figures(record: dict, out: Path) -> list[Path]:
+    a = _learning_arrays(record)
+    ep = a["episode"]
+    n = len(ep)
+    window = min(100, max(1, n // 5))
+    paths = []
+
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    ax.plot(ep, np.nanmean(a["reward"], axis=0), color="0.6", lw=0.8, label="mean over trials")
+    centers, means, stds = [], [], []
+    for start in range(0, n, window):
+        block = a["reward"][:, start : start + window]
+        centers.append(ep[start] + (min(window, n - start) - 1) / 2)
+        means.append(np.nanmean(block))
+        stds.append(np.nanstd(block))
+    ax.errorbar(centers, means, yerr=stds, fmt="o-", color="C0", capsize=3,
+                label=f"{window}-episode blocks (± std, all trials)")
+    ax.set_xlabel("episode")
+    ax.set_ylabel("reward (distance fraction / C_mt)")
+    ax.set_title(f"Fig. 4: reward, {len(record['trials'])} trials")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    paths.append(out / "fig4_reward.png")
+    fig.savefig(paths[-1], dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    per_episode = np.nanmean(a["cmt"], axis=0)
+    ax.plot(ep, per_episode, ".", color="0.7", ms=3, label="mean over trials (walks only)")
+    ax.plot(ep, _moving_average(per_episode, window), color="C3", label=f"{window}-episode moving average")
+    ev = record.get("evaluation") or {}
+    if ev.get("no_window", {}).get("cost_of_transport"):
+        ax.axhline(ev["no_window"]["cost_of_transport"], color="k", ls="--", lw=0.8, label="no torque-free period")
+    ax.set_xlabel("episode")
+    ax.set_ylabel("C_mt")
+    ax.set_title("Fig. 5: cost of transport")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    paths.append(out / "fig5_cmt.png")
+    fig.savefig(paths[-1], dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for key, color, name in (("1", "C0", "t̄1 (start)"), ("2", "C1", "t̄2 (end)")):
+        ax.plot(ep, _moving_average(np.nanmean(a[f"t{key}"], axis=0), window), color=color, lw=0.8, alpha=0.5,
+                label=f"sampled t{key}, {window}-episode moving average")
+        ax.plot(ep, np.nanmean(a[f"mean_t{key}"], axis=0), color=color, lw=2, label=f"policy mean {name}")
+    ax.set_xlabel("episode")
+    ax.set_ylabel("time after step start (s)")
+    ax.set_title("Fig. 6: torque-free start and end times (mean over trials)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    paths.append(out / "fig6_times.png")
+    fig.savefig(paths[-1], dpi=120)
+    plt.close(fig)
+
+    paths.append(out / "table_v.md")
+    paths[-1].write_text(table_v(record))
+    return paths
+
+
+def table_v(record: dict) -> str:
+    ev = record.get("evaluation") or {}
+    base = (ev.get("no_window") or {}).get("cost_of_transport")
+    learned = ev.get("learned_mean_cost_of_transport")
+
+    def fmt(x):
+        return "—" if x is None else f"{x:.3f}"
+
+    ours_learned = fmt(learned)
+    if learned is not None:
+        ours_learned += f" ± {ev['learned_std_cost_of_transport']:.3f} ({ev['learned_walks']} of {len(ev['learned'])} trials walk)"
+    reduction = ev.get("reduction")
+    lines = [
+        "# Table V: cost of transport C_mt = E+ / (m g d)",
+        "",
+        "| | ASIMO | CPG without torque-free period | CPG with the learned torque-free period | human |",
+        "|---|---|---|---|---|",
+        f"| paper | {TABLE_V_PAPER['ASIMO']:.2f} | {TABLE_V_PAPER['CPG without torque-free period']:.2f} | "
+        f"{TABLE_V_PAPER['CPG with torque-free period']:.2f} | {TABLE_V_PAPER['human']:.2f} |",
+        f"| ours (measured) | — | {fmt(base)} | {ours_learned} | — |",
+        "",
+        f"Reduction: paper {100 * (1 - 0.29 / 0.58):.0f} %, ours "
+        + ("—" if reduction is None else f"{100 * reduction:.1f} %")
+        + f". Ours: one {record['settings']['config']['sim']['distance_m']:g} m walk without a window, and one with "
+        "each trial's final policy mean (t̄1, t̄2):",
+        "",
+        "| trial | t̄1 (s) | t̄2 (s) | C_mt | walked |",
+        "|---|---|---|---|---|",
+    ]
+    for r in ev.get("learned", []):
+        lines.append(f"| {r['trial']} | {r['t1']:.3f} | {r['t2']:.3f} | {fmt(r['cost_of_transport'])} | "
+                     f"{'yes' if not r['fell'] else 'no'} |")
+    return "\n".join(lines) + "\n"

@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -221,6 +221,48 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_learn(args: argparse.Namespace) -> int:
+    from drake_biped.learning import learn, make_settings
+    from drake_biped.parallel import check_scheduler_address
+
+    config = _episode_config(args)
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
+        if args.workers is not None:
+            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+    settings = make_settings(config, args.trials, args.episodes, args.seed if args.seed is not None else 0)
+    out = Path(args.out)
+    record = learn(out, settings, workers=args.workers, scheduler=args.scheduler)
+    ev = record["evaluation"]
+    print((out / "table_v.md").read_text())
+    base = ev["no_window"]["cost_of_transport"]
+    if ev.get("reduction") is not None:
+        print(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
+              f"{ev['learned_mean_cost_of_transport']:.3f}: {100 * ev['reduction']:.1f} % lower")
+    run = json.loads((out / "run.json").read_text())
+    if run["episodes_per_min"]:
+        print(f"{run['episodes_this_run']} episodes in {run['learning_wall_s']:.0f} s "
+              f"({run['episodes_per_min']:.1f} episodes/min)")
+    print(f"wrote {out}/learning.json, fig4_reward.png, fig5_cmt.png, fig6_times.png, table_v.md")
+    return 0
+
+
+def cmd_figures(args: argparse.Namespace) -> int:
+    from analysis.figures import learning_figures
+
+    out = Path(args.dir)
+    path = out / "learning.json"
+    if not path.is_file():
+        raise ParameterError(f"figures: no learning.json in {out}")
+    try:
+        record = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"figures: {path} is not valid JSON ({exc})") from None
+    for p in learning_figures(record, out):
+        print(f"wrote {p}")
+    return 0
+
+
 def _steps(text: str) -> list[float]:
     parse = _number("positive")
     return [parse(t) for t in text.split(",")]
@@ -268,6 +310,19 @@ def build_parser() -> argparse.ArgumentParser:
     ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
     ts.add_argument("--out", required=True, help="output folder")
     ts.set_defaults(func=cmd_time_step_study)
+
+    learn = sub.add_parser("learn", help="GARB learning of the torque-free period (Experiment 1), on Dask")
+    _add_episode_options(learn)
+    learn.add_argument("--trials", type=_count, default=5, help="independent trials (default 5)")
+    learn.add_argument("--episodes", type=_count, default=500, help="episodes per trial (default 500)")
+    learn.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
+    learn.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    learn.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    learn.set_defaults(func=cmd_learn)
+
+    figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
+    figs.add_argument("dir", help="the learning run's output folder")
+    figs.set_defaults(func=cmd_figures)
     return parser
 
 

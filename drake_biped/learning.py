@@ -1,0 +1,275 @@
+"""A learning run (Experiment 1): trials x episodes of GARB learning the torque-free period, on Dask.
+
+Each trial is a GarbLearner with its own seed; its episodes are sequential (episode i+1 samples from the
+policy that episode i updated). Trials run in parallel: the driver (this process) holds the learners and
+submits one episode task per trial at a time, each as soon as that trial's previous episode is recorded,
+so the workers stay busy whatever the number of trials. Workers receive EpisodeConfig dictionaries.
+
+Nothing lost: after every episode the trial's record (every episode so far and the learner's state) is
+rewritten atomically (temporary file + rename) in OUT/trials/trial_K.json. Rerunning the same command
+resumes every trial from its last recorded episode, and, since episodes are deterministic and the learner
+carries its random generator, ends with exactly the result of an uninterrupted run. A worker that dies
+costs the episode it was running: Dask runs that task again elsewhere. A rerun may ask for more trials or
+episodes (a trial runs until it holds at least --episodes; one that holds more keeps them all, and its
+evaluation uses the policy it ended with); seed, configuration and learner must match.
+
+Reward (eq. 13, with a fall rule): r = (d / D) / C_mt, where C_mt = E+ / (m g d) is the dimensionless cost
+of transport (as in Table V), d the distance walked (capped at D) and D the episode's target distance
+(10 m). A walk that completes gets 1 / C_mt; a fall is scaled down by the fraction of the distance it
+covered: without that factor a fall after half a metre, having spent little energy, would out-earn a
+complete walk. No distance or no work: r = 0.
+
+Sampled times below 0 act as 0 in the episode (the learner updates with the sample itself); t2 <= t1
+means no torque-free period, as in the paper.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.garb import TABLE_II, GarbLearner
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.versions import versions
+
+RECORD_VERSION = 1
+
+
+def reward(cost_of_transport: float | None, distance_m: float, target_m: float) -> float:
+    """The documented reward (module docstring)."""
+    if cost_of_transport is None or not np.isfinite(cost_of_transport) or cost_of_transport <= 0:
+        return 0.0
+    if distance_m <= 0 or target_m <= 0:
+        return 0.0
+    return min(distance_m / target_m, 1.0) / cost_of_transport
+
+
+def trial_seed(seed: int, trial: int) -> int:
+    """The learner seed of trial `trial` in a run seeded `seed` (independent streams per trial)."""
+    return int(np.random.SeedSequence([seed, trial]).generate_state(1)[0])
+
+
+def window_of(sample: np.ndarray) -> TorqueFreeWindow:
+    t1, t2 = (max(0.0, min(float(x), 10.0)) for x in sample)
+    return TorqueFreeWindow(t1, t2)
+
+
+def write_atomic(path: Path, data: dict) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w") as f:
+        json.dump(data, f, indent=1, allow_nan=False)
+        f.write("\n")
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
+    """The settings a trial's record must share with the command resuming it: all but how many trials and
+    episodes (a run may be extended; the schedule depends on the episode number only)."""
+    return {k: v for k, v in settings.items() if k not in ("trials", "episodes")}
+
+
+class Trial:
+    """One trial's learner and record, kept on disk after every episode."""
+
+    def __init__(self, out: Path, index: int, settings: dict[str, Any]):
+        self.index = index
+        self.path = out / "trials" / f"trial_{index}.json"
+        self.settings = settings
+        self.config = EpisodeConfig.from_dict(settings["config"])
+        if self.path.is_file():
+            record = json.loads(self.path.read_text())
+            if _fixed(record.get("settings", {})) != _fixed(settings):
+                raise ParameterError(
+                    f"{self.path} was made with other settings (seed, episodes' config or learner); "
+                    "use another --out, or the original options to resume"
+                )
+            self.episodes: list[dict[str, Any]] = record["episodes"]
+            self.learner = GarbLearner.from_state(record["learner"])
+        else:
+            self.episodes = []
+            ls = settings["learner"]
+            self.learner = GarbLearner(ls["mean"], ls["variance"], ls["beta"], [tuple(b) for b in ls["schedule"]],
+                                       seed=trial_seed(settings["seed"], index))
+        self.pending: np.ndarray | None = None
+
+    @property
+    def done(self) -> int:
+        return len(self.episodes)
+
+    def next_config(self) -> dict[str, Any]:
+        """Sample the next episode's window; its EpisodeConfig as a dictionary for a worker."""
+        self.pending = self.learner.sample()
+        return self.config.replace(window=window_of(self.pending), seed=self.settings["seed"]).to_dict()
+
+    def record(self, result: dict[str, Any]) -> dict[str, Any]:
+        """Update the learner with the finished episode and write the trial's record."""
+        sample, self.pending = self.pending, None
+        r = reward(result["cost_of_transport"], result["distance_m"], self.config.sim.distance_m)
+        self.learner.update(sample, r)
+        row = {
+            "episode": self.done + 1,
+            "t1": float(sample[0]),
+            "t2": float(sample[1]),
+            "mean_t1": float(self.learner.mean[0]),
+            "mean_t2": float(self.learner.mean[1]),
+            "reward": r,
+            "baseline": self.learner.baseline,
+            "cost_of_transport": result["cost_of_transport"],
+            "distance_m": result["distance_m"],
+            "fell": result["fell"],
+            "fall_reason": result["fall_reason"],
+            "duration_s": result["duration_s"],
+            "steps": len(result["steps"]),
+        }
+        self.episodes.append(row)
+        write_atomic(self.path, {"record_version": RECORD_VERSION, "trial": self.index,
+                                 "learner_seed": trial_seed(self.settings["seed"], self.index),
+                                 "settings": self.settings, "episodes": self.episodes,
+                                 "learner": self.learner.state()})
+        return row
+
+
+def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
+                  mean=(0.5, 0.5), variance: float = 0.04, beta: float = 0.8, schedule=TABLE_II) -> dict[str, Any]:
+    if not isinstance(trials, int) or trials < 1:
+        raise ParameterError(f"--trials {trials!r}: must be an integer >= 1")
+    if not isinstance(episodes, int) or episodes < 1:
+        raise ParameterError(f"--episodes {episodes!r}: must be an integer >= 1")
+    if not isinstance(seed, int) or seed < 0:
+        raise ParameterError(f"--seed {seed!r}: must be an integer >= 0")
+    GarbLearner(mean, variance, beta, schedule)  # validates
+    return {
+        "trials": trials,
+        "episodes": episodes,
+        "seed": seed,
+        "config": config.replace(window=TorqueFreeWindow(0.0, 0.0)).to_dict(),
+        "learner": {"mean": list(map(float, mean)), "variance": float(variance), "beta": float(beta),
+                    "schedule": [list(b) for b in schedule]},
+    }
+
+
+def run_learning(
+    out: Path,
+    settings: dict[str, Any],
+    client,
+    progress: Callable[[int, int, float | None], None] | None = None,
+    stop_after: int | None = None,
+) -> tuple[list[Trial], int]:
+    """Run (or resume) every trial to settings["episodes"] on the Dask `client`.
+
+    progress(done, total, latest_mean_reward) after each recorded episode. stop_after: return once this
+    many new episodes are recorded (for tests of resuming). Returns the trials and the number of episodes
+    this call recorded."""
+    from distributed import as_completed
+
+    from drake_biped.parallel import episode_task
+
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "trials").mkdir(exist_ok=True)
+    trials = [Trial(out, k, settings) for k in range(settings["trials"])]
+    total = settings["trials"] * settings["episodes"]
+    done = sum(t.done for t in trials)
+    latest: dict[int, float] = {t.index: t.episodes[-1]["reward"] for t in trials if t.episodes}
+    if progress is not None:
+        progress(done, total, float(np.mean(list(latest.values()))) if latest else None)
+    futures = {}
+    for t in trials:
+        if t.done < settings["episodes"]:
+            futures[client.submit(episode_task, t.next_config(), pure=False)] = t
+    new = 0
+    queue = as_completed(list(futures))
+    for future in queue:
+        t = futures.pop(future)
+        row = t.record(future.result())
+        new += 1
+        latest[t.index] = row["reward"]
+        if progress is not None:
+            progress(sum(x.done for x in trials), total, float(np.mean(list(latest.values()))))
+        if stop_after is not None and new >= stop_after:
+            for f in futures:
+                f.cancel()
+            break
+        if t.done < settings["episodes"]:
+            f = client.submit(episode_task, t.next_config(), pure=False)
+            futures[f] = t
+            queue.add(f)
+    return trials, new
+
+
+def evaluate(settings: dict[str, Any], trials: list[Trial], client) -> dict[str, Any]:
+    """Table V's measured rows: the gait without a window, and with each trial's final policy mean."""
+    from drake_biped.parallel import episode_task
+
+    base = EpisodeConfig.from_dict(settings["config"])
+    configs = [base.to_dict()] + [base.replace(window=window_of(t.learner.mean)).to_dict() for t in trials]
+    results = client.gather([client.submit(episode_task, c, pure=False) for c in configs])
+    keep = ("cost_of_transport", "distance_m", "fell", "mean_speed_mps", "step_period_s")
+    rows = [{k: r[k] for k in keep} for r in results]
+    learned = [dict(row, trial=t.index, t1=float(t.learner.mean[0]), t2=float(t.learner.mean[1]))
+               for t, row in zip(trials, rows[1:])]
+    walked = [r["cost_of_transport"] for r in learned if not r["fell"] and r["cost_of_transport"]]
+    out = {"no_window": rows[0], "learned": learned}
+    if walked and rows[0]["cost_of_transport"] and not rows[0]["fell"]:
+        out["learned_mean_cost_of_transport"] = float(np.mean(walked))
+        out["learned_std_cost_of_transport"] = float(np.std(walked))
+        out["reduction"] = 1.0 - out["learned_mean_cost_of_transport"] / rows[0]["cost_of_transport"]
+    out["learned_walks"] = len(walked)
+    return out
+
+
+def learning_record(settings: dict[str, Any], trials: list[Trial], evaluation: dict[str, Any] | None) -> dict:
+    """The contents of learning.json (no wall times: a resumed run writes the same file)."""
+    return {
+        "record_version": RECORD_VERSION,
+        "settings": settings,
+        "versions": {k: v for k, v in versions().items()},
+        "trials": [{"trial": t.index, "learner_seed": trial_seed(settings["seed"], t.index),
+                    "episodes": t.episodes, "final_mean": t.learner.mean.tolist()} for t in trials],
+        "evaluation": evaluation,
+    }
+
+
+def learn(out: Path, settings: dict[str, Any], workers: int | None = None, scheduler: str | None = None,
+          progress: bool = True) -> dict[str, Any]:
+    """Run or resume the learning, evaluate, write learning.json, run.json, the figures and Table V."""
+    from analysis.figures import learning_figures
+    from drake_biped.parallel import dask_client
+
+    t0 = time.perf_counter()
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=settings["trials"] * settings["episodes"], desc="learning", unit="episode")
+
+    def report(done: int, total: int, latest: float | None) -> None:
+        if bar is not None:
+            bar.n = done
+            bar.set_postfix_str("" if latest is None else f"latest mean reward {latest:.3f}", refresh=False)
+            bar.refresh()
+
+    try:
+        with dask_client(workers=workers, scheduler=scheduler) as client:
+            trials, new = run_learning(out, settings, client, report)
+            t_learn = time.perf_counter() - t0
+            evaluation = evaluate(settings, trials, client)
+    finally:
+        if bar is not None:
+            bar.close()
+    record = learning_record(settings, trials, evaluation)
+    write_atomic(out / "learning.json", record)
+    wall = time.perf_counter() - t0
+    write_atomic(out / "run.json", {
+        "wall_s": wall, "learning_wall_s": t_learn, "episodes_this_run": new,
+        "episodes_per_min": 60.0 * new / t_learn if new and t_learn > 0 else None,
+        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "workers": workers, "scheduler": scheduler})
+    learning_figures(record, out)
+    return record

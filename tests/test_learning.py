@@ -1,0 +1,111 @@
+"""The learning run: its reward rule, its records, and a run interrupted and resumed."""
+
+import json
+
+import numpy as np
+import pytest
+
+from drake_biped.cli import main
+from drake_biped.learning import Trial, make_settings, reward, run_learning, trial_seed, window_of
+from drake_biped.parallel import dask_client
+from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
+
+
+def test_reward_is_inverse_cost_of_transport_scaled_by_the_distance_covered():
+    assert reward(0.25, 10.0, 10.0) == pytest.approx(4.0)
+    assert reward(0.25, 12.0, 10.0) == pytest.approx(4.0)  # overshoot of the last step: capped
+    assert reward(0.25, 5.0, 10.0) == pytest.approx(2.0)  # a fall half-way
+    # A fall after 0.3 m with little work has a small C_mt but must not out-earn a complete walk.
+    assert reward(0.10, 0.3, 10.0) < reward(0.25, 10.0, 10.0)
+    assert reward(None, 3.0, 10.0) == 0.0
+    assert reward(0.2, 0.0, 10.0) == 0.0
+    assert reward(0.2, -0.1, 10.0) == 0.0
+
+
+def test_sampled_times_map_to_a_window():
+    w = window_of(np.array([-0.1, 0.4]))
+    assert (w.start_s, w.end_s) == (0.0, 0.4)
+    assert not window_of(np.array([0.6, 0.3])).active  # t2 <= t1: no torque-free period
+
+
+def test_trials_get_distinct_reproducible_seeds():
+    assert trial_seed(0, 0) == trial_seed(0, 0)
+    assert len({trial_seed(0, k) for k in range(5)} | {trial_seed(1, 0)}) == 6
+
+
+def _settings(episodes=4, trials=2):
+    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    return make_settings(config, trials, episodes, seed=3)
+
+
+def _episodes(out):
+    return [json.loads(p.read_text())["episodes"] for p in sorted((out / "trials").glob("trial_*.json"))]
+
+
+def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
+    settings = _settings()
+    with dask_client(workers=1) as client:
+        whole, n_whole = run_learning(tmp_path / "whole", settings, client)
+        _, n_first = run_learning(tmp_path / "cut", settings, client, stop_after=3)
+        cut = _episodes(tmp_path / "cut")
+        resumed, n_rest = run_learning(tmp_path / "cut", settings, client)
+    assert n_whole == 8 and n_first == 3 and n_rest == 5
+    assert sum(len(e) for e in cut) == 3
+    assert _episodes(tmp_path / "cut") == _episodes(tmp_path / "whole")
+    for a, b in zip(whole, resumed):
+        assert a.learner.state() == b.learner.state()
+    # The policy moved, and every episode's record holds what the figures need.
+    first = _episodes(tmp_path / "whole")[0]
+    assert [e["episode"] for e in first] == [1, 2, 3, 4]
+    assert (first[-1]["mean_t1"], first[-1]["mean_t2"]) != (0.5, 0.5)
+    assert {"t1", "t2", "reward", "cost_of_transport", "distance_m", "fell"} <= set(first[0])
+
+
+def test_resuming_with_other_settings_is_refused(tmp_path):
+    settings = _settings()
+    (tmp_path / "trials").mkdir()
+    trial = Trial(tmp_path, 0, settings)
+    trial.next_config()
+    trial.record({"cost_of_transport": 0.2, "distance_m": 0.6, "fell": False, "fall_reason": "",
+                  "duration_s": 1.0, "steps": []})
+    other = dict(settings, seed=4)
+    with pytest.raises(ParameterError, match="other settings"):
+        Trial(tmp_path, 0, other)
+
+
+def test_figures_are_redrawn_from_the_records_alone(tmp_path):
+    episodes = [{"episode": i + 1, "t1": 0.2, "t2": 0.5, "mean_t1": 0.5 - 0.001 * i, "mean_t2": 0.5,
+                 "reward": 4.0 + 0.01 * i, "baseline": 4.0, "cost_of_transport": 0.25, "distance_m": 10.0,
+                 "fell": i % 7 == 0, "fall_reason": "", "duration_s": 15.0, "steps": 18} for i in range(30)]
+    record = {
+        "settings": _settings(episodes=30),
+        "trials": [{"trial": k, "episodes": episodes} for k in range(2)],
+        "evaluation": {"no_window": {"cost_of_transport": 0.221, "fell": False},
+                       "learned": [{"trial": 0, "t1": 0.15, "t2": 0.55, "cost_of_transport": 0.140, "fell": False},
+                                   {"trial": 1, "t1": 0.20, "t2": 0.50, "cost_of_transport": 0.160, "fell": False}],
+                       "learned_mean_cost_of_transport": 0.150, "learned_std_cost_of_transport": 0.010,
+                       "learned_walks": 2, "reduction": 1 - 0.150 / 0.221},
+    }
+    (tmp_path / "learning.json").write_text(json.dumps(record))
+    assert main(["figures", str(tmp_path)]) == 0
+    for name in ("fig4_reward.png", "fig5_cmt.png", "fig6_times.png", "table_v.md"):
+        assert (tmp_path / name).stat().st_size > 0
+    table = (tmp_path / "table_v.md").read_text()
+    assert "| paper | 1.60 | 0.58 | 0.29 | 0.05 |" in table
+    assert "0.221" in table and "0.150 ± 0.010" in table and "32.1 %" in table
+
+
+def test_figures_without_a_record_is_a_clear_error(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        main(["figures", str(tmp_path)])
+    assert "no learning.json" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--trials", "0"], "--trials"), (["--episodes", "x"], "--episodes"),
+    (["--scheduler", "localhost"], "scheduler"), (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "workers"),
+])
+def test_learn_refuses_bad_options(tmp_path, capsys, argv, match):
+    with pytest.raises(SystemExit):
+        main(["learn", "--out", str(tmp_path), *argv])
+    assert match in capsys.readouterr().err
