@@ -230,7 +230,8 @@ def cmd_learn(args: argparse.Namespace) -> int:
         check_scheduler_address(args.scheduler)
         if args.workers is not None:
             raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
-    settings = make_settings(config, args.trials, args.episodes, args.seed if args.seed is not None else 0)
+    settings = make_settings(config, args.trials, args.episodes, args.seed if args.seed is not None else 0,
+                             mean=tuple(args.initial_mean), variance=args.variance)
     out = Path(args.out)
     record = learn(out, settings, workers=args.workers, scheduler=args.scheduler)
     ev = record["evaluation"]
@@ -315,6 +316,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_episode_options(learn)
     learn.add_argument("--trials", type=_count, default=5, help="independent trials (default 5)")
     learn.add_argument("--episodes", type=_count, default=500, help="episodes per trial (default 500)")
+    learn.add_argument("--initial-mean", type=_number("nonnegative"), nargs=2, default=[0.5, 0.5],
+                       metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
+    learn.add_argument("--variance", type=_number("positive"), default=0.04,
+                       help="the policy's variance per time (s^2); default 0.04 as in the paper")
     learn.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
     learn.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
     learn.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")

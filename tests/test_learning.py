@@ -103,7 +103,8 @@ def test_figures_without_a_record_is_a_clear_error(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv, match", [
     (["--trials", "0"], "--trials"), (["--episodes", "x"], "--episodes"),
-    (["--scheduler", "localhost"], "scheduler"), (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "workers"),
+    (["--scheduler", "localhost"], "scheduler"), (["--initial-mean", "0.4"], "--initial-mean"),
+    (["--initial-mean", "0.4", "-1"], "--initial-mean"), (["--variance", "0"], "--variance"), (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "workers"),
 ])
 def test_learn_refuses_bad_options(tmp_path, capsys, argv, match):
     with pytest.raises(SystemExit):
