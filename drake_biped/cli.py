@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -190,7 +190,8 @@ def cmd_window_map(args: argparse.Namespace) -> int:
     from drake_biped.window_map import run_window_map
 
     config = _episode_config(args)
-    run_window_map(config, Path(args.out), t1_step=args.step, t2_step=args.step, workers=args.workers)
+    run_window_map(config, Path(args.out), t1_step=args.step, t2_step=args.step, workers=args.workers,
+                   t1_max=args.t1_max, t2_max=args.t2_max)
     return 0
 
 
@@ -264,6 +265,38 @@ def cmd_figures(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_landscape(args: argparse.Namespace) -> int:
+    from analysis.policy_landscape import WindowRewards, landscape, landscape_figure
+    from drake_biped.learning import write_atomic
+    from drake_biped.versions import versions
+
+    source = Path(args.window_map)
+    path = source / "window_map.json" if source.is_dir() else source
+    if not path.is_file():
+        raise ParameterError(f"landscape: no window map at {source} (run drake-biped window-map first)")
+    try:
+        wmap = json.loads(path.read_text())
+        rewards = WindowRewards.from_window_map(wmap)
+    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+        raise ParameterError(f"landscape: {path} is not a window map ({exc})") from None
+    starts = [tuple(args.start)] if args.start else [(0.5, 0.5)]
+    record = landscape(rewards, args.variance, samples=args.samples, seed=args.seed or 0, starts=starts)
+    record.update(window_map=str(path), samples=args.samples, seed=args.seed or 0, versions=versions())
+    out = Path(args.out) if args.out else path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "landscape.json", record)
+    landscape_figure(record, out / "landscape.png")
+    base = record["no_window_reward"]
+    print(f"no window: reward {base:.3f}")
+    for cell in record["variances"]:
+        s = cell["starts"][0]
+        print(f"variance {cell['variance']:g}: best policy mean ({cell['best_mean'][0]:.3f}, {cell['best_mean'][1]:.3f}) "
+              f"expected reward {100 * cell['best_gain']:+.1f} % vs no window; at the start {tuple(s['mean'])} "
+              f"{100 * s['gain']:+.1f} %")
+    print(f"wrote {out}/landscape.json, landscape.png")
+    return 0
+
+
 def _steps(text: str) -> list[float]:
     parse = _number("positive")
     return [parse(t) for t in text.split(",")]
@@ -288,6 +321,8 @@ def build_parser() -> argparse.ArgumentParser:
     wmap = sub.add_parser("window-map", help="C_mt of a grid of torque-free windows against no window")
     _add_episode_options(wmap)
     wmap.add_argument("--step", type=_number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
+    wmap.add_argument("--t1-max", type=_number("nonnegative"), default=0.6, help="largest start t1 (s); default 0.6")
+    wmap.add_argument("--t2-max", type=_number("positive"), default=0.9, help="largest end t2 (s); default 0.9")
     wmap.add_argument("--workers", type=_count, default=2, help="parallel processes (default 2)")
     wmap.add_argument("--out", required=True, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
@@ -324,6 +359,17 @@ def build_parser() -> argparse.ArgumentParser:
     learn.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
     learn.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
     learn.set_defaults(func=cmd_learn)
+
+    land = sub.add_parser("landscape", help="the expected reward GARB climbs, from a window map, for given variances")
+    land.add_argument("window_map", help="a window-map output folder or its window_map.json")
+    land.add_argument("--variance", type=_steps, default=[0.04, 0.01, 0.0025],
+                      help="policy variances (s^2), comma-separated; default 0.04,0.01,0.0025")
+    land.add_argument("--start", type=_number("nonnegative"), nargs=2, metavar=("T1", "T2"),
+                      help="a policy start to evaluate (default 0.5 0.5)")
+    land.add_argument("--samples", type=_count, default=2000, help="Monte Carlo samples per mean (default 2000)")
+    land.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    land.add_argument("--out", default=None, help="output folder (default: the window map's)")
+    land.set_defaults(func=cmd_landscape)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")

@@ -74,12 +74,12 @@ def _bar(iterable, enabled: bool, total: int | None = None):
 
 
 def run_window_map(config: EpisodeConfig, out: Path, t1_step: float = 0.1, t2_step: float = 0.1,
-                   workers: int = 2) -> dict:
+                   workers: int = 2, t1_max: float = 0.6, t2_max: float = 0.9) -> dict:
     """Evaluate the grid, write window_map.json / .csv / .png into `out`, and return the record."""
     from analysis.figures import window_map_figure
 
     out.mkdir(parents=True, exist_ok=True)
-    baseline, rows = evaluate_windows(config, window_grid(t1_step=t1_step, t2_step=t2_step), workers)
+    baseline, rows = evaluate_windows(config, window_grid(t1_max, t2_max, t1_step, t2_step), workers)
     record = {"config": config.to_dict(), "baseline": baseline, "windows": rows, "versions": versions()}
     (out / "window_map.json").write_text(json.dumps(record, indent=2) + "\n")
     with open(out / "window_map.csv", "w", newline="") as f:
