@@ -243,6 +243,7 @@ def learn(out: Path, settings: dict[str, Any], workers: int | None = None, sched
     from analysis.figures import learning_figures
     from drake_biped.parallel import dask_client
 
+    versions()  # the code version this process runs, recorded now (it is cached), not at the run's end
     t0 = time.perf_counter()
     bar = None
     if progress:

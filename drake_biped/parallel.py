@@ -57,6 +57,9 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
+        # The scheduler's HTTP endpoints (health, metrics) on a free port, not 8787: no clash, and no
+        # warning, when another cluster runs on the machine.
+        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
         silence_logs=40,
     )
     client = Client(cluster)
