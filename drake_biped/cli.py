@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -10,6 +10,8 @@ import json
 import math
 import sys
 from pathlib import Path
+
+import numpy as np
 
 from drake_biped.params import (
     EpisodeConfig,
@@ -297,6 +299,65 @@ def cmd_landscape(args: argparse.Namespace) -> int:
     return 0
 
 
+def _policy_window(path: Path) -> tuple[float, float]:
+    """The learned torque-free period of a learning run: the mean of its trials' final policy means."""
+    if not path.is_file():
+        raise ParameterError(f"--policy: no such file: {path}")
+    try:
+        means = np.array([t["final_mean"] for t in json.loads(path.read_text())["trials"]], dtype=float)
+    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+        raise ParameterError(f"--policy {path}: not a learning.json ({exc})") from None
+    t1, t2 = (max(0.0, float(x)) for x in means.mean(axis=0))
+    if t2 <= t1:
+        raise ParameterError(f"--policy {path}: the learned policy has no torque-free period "
+                             f"(mean t1 {t1:.3f} s >= t2 {t2:.3f} s); give --t1 and --t2")
+    return t1, t2
+
+
+def cmd_stability(args: argparse.Namespace) -> int:
+    from analysis.stability_report import write_stability_outputs
+    from drake_biped.learning import write_atomic
+    from drake_biped.parallel import check_scheduler_address, dask_client
+    from drake_biped.stability import StabilitySettings, run_stability
+
+    config = _episode_config(args)
+    if args.policy is not None and args.t1 is not None:
+        raise ParameterError("give either --policy or --t1/--t2, not both")
+    if (args.t1 is None) != (args.t2 is None):
+        raise ParameterError("--t1 and --t2 go together: give both or neither")
+    if args.policy is not None:
+        window = _policy_window(Path(args.policy))
+    elif args.t1 is not None:
+        window = (args.t1, args.t2)
+    else:
+        window = (0.2, 0.5)
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
+        if args.workers is not None:
+            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+    settings = StabilitySettings(window=window, trials=args.trials, push_force_n=args.push,
+                                 spread=args.spread, seed=config.seed)
+    out = Path(args.out)
+    from tqdm import tqdm
+
+    bar = tqdm(total=6 * settings.trials, desc="stability", unit="episode")
+
+    def progress(done: int, total: int) -> None:
+        bar.n = done
+        bar.refresh()
+
+    try:
+        with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+            record = run_stability(out, config, settings, client, progress)
+    finally:
+        bar.close()
+    write_atomic(out / "stability.json", record)
+    write_stability_outputs(record, out)
+    print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
+    print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
+    return 0
+
+
 def _steps(text: str) -> list[float]:
     parse = _number("positive")
     return [parse(t) for t in text.split(",")]
@@ -370,6 +431,21 @@ def build_parser() -> argparse.ArgumentParser:
     land.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     land.add_argument("--out", default=None, help="output folder (default: the window map's)")
     land.set_defaults(func=cmd_landscape)
+
+    stab = sub.add_parser("stability", help="pushes and Poincare return maps with and without a torque-free "
+                          "period (Table VI, Fig. 7), on Dask")
+    _add_episode_options(stab)
+    stab.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
+    stab.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
+    stab.add_argument("--policy", default=None, help="a learning.json: use its learned torque-free period")
+    stab.add_argument("--trials", type=_count, default=8, help="trials per cell (default 8)")
+    stab.add_argument("--push", type=_number("positive"), default=20.0, help="push force (N); default 20")
+    stab.add_argument("--spread", type=_number("nonnegative"), default=0.15,
+                      help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
+    stab.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
+    stab.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    stab.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    stab.set_defaults(func=cmd_stability)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")

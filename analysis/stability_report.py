@@ -1,0 +1,158 @@
+"""Fig. 7 and the stability report (Table VI beside the paper's), drawn from a stability record alone."""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+CONDITIONS = ("without", "with")
+DISTURBANCES = ("undisturbed", "forward", "backward")
+# Fig. 7's colours for 0-4 steps after the push; later steps grey.
+STEP_COLOURS = ("red", "green", "purple", "blue", "black")
+CONDITION_NAMES = {"without": "without torque-free period", "with": "with torque-free period"}
+
+
+def _eig_text(pairs) -> str:
+    out = []
+    for re, im in pairs:
+        out.append(f"{re:.3f}" if abs(im) < 5e-4 else f"{re:.3f}{'+' if im >= 0 else '−'}{abs(im):.3f}i")
+    return ", ".join(out)
+
+
+def fig7(record: dict, path: str | Path) -> None:
+    """Return-map scatter of the inter-leg hip angle (deviation from x*): x_n against x_{n+1}, coloured by
+    the number of steps after the push."""
+    cells = record["cells"]
+    fig, axes = plt.subplots(2, 3, figsize=(11, 7), sharex=True, sharey=True)
+    for i, condition in enumerate(CONDITIONS):
+        x_star = np.array(cells[condition]["equilibrium"])
+        for j, kind in enumerate(DISTURBANCES):
+            ax = axes[i, j]
+            cell = cells[condition][kind]
+            for seq, since in zip(cell["sequences"], cell["steps_since_push"]):
+                s = np.array(seq).reshape(-1, 2)
+                if len(s) < 2:
+                    continue
+                d = (s[:, 0] - x_star[0]) * 1e3
+                for n in range(len(s) - 1):
+                    k = since[n]
+                    colour = STEP_COLOURS[k] if 0 <= k < len(STEP_COLOURS) else "0.6"
+                    ax.plot(d[n], d[n + 1], "o", ms=3.5, color=colour, alpha=0.8)
+            ax.axhline(0, color="0.85", lw=0.6)
+            ax.axvline(0, color="0.85", lw=0.6)
+            rho = cell.get("spectral_radius")
+            title = f"{kind}: ρ = {rho:.3f}" if rho is not None else f"{kind}: no fit"
+            ax.set_title(title, fontsize=9)
+            if j == 0:
+                ax.set_ylabel(f"{CONDITION_NAMES[condition]}\nθ_(n+1) − θ* [mrad]", fontsize=8)
+            if i == 1:
+                ax.set_xlabel("θ_n − θ* [mrad]", fontsize=8)
+    lo, hi = axes[0, 0].get_xlim()
+    for ax in axes.flat:
+        ax.plot([lo, hi], [lo, hi], ":", color="0.5", lw=0.8)
+        ax.set_xlim(lo, hi)
+        ax.set_ylim(lo, hi)
+    handles = [plt.Line2D([], [], ls="", marker="o", color=c,
+                          label=f"{k} step{'' if k == 1 else 's'} after the push")
+               for k, c in enumerate(STEP_COLOURS)]
+    handles.append(plt.Line2D([], [], ls="", marker="o", color="0.6", label="later / undisturbed"))
+    fig.legend(handles=handles, loc="lower center", ncol=6, fontsize=8)
+    fig.suptitle("Fig. 7: Poincaré return map of the inter-leg hip angle θ at touchdown", fontsize=10)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.97))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _rows(record: dict) -> list[dict]:
+    rows = []
+    for condition in CONDITIONS:
+        for kind in DISTURBANCES:
+            cell = record["cells"][condition][kind]
+            ci = cell.get("spectral_radius_ci")
+            rho = cell.get("spectral_radius")
+            rows.append({
+                "cell": f"{CONDITION_NAMES[condition]}, {kind}",
+                "paper": _eig_text(cell["paper_eigenvalues"]),
+                "paper_rho": f"{cell['paper_spectral_radius']:.3f}",
+                "ours": _eig_text(cell["eigenvalues"]) if "eigenvalues" in cell else "—",
+                "rho": "—" if rho is None else f"{rho:.3f}",
+                "ci": "—" if not ci else f"[{ci[0]:.3f}, {ci[1]:.3f}]",
+                "pairs": str(cell.get("n_pairs", 0)),
+                "falls": f"{cell['falls']}/{cell['trials']}",
+                "verdict": ("no fit: " + cell["error"]) if "error" in cell else
+                           ("stable (ρ < 1)" if cell["stable"] else "unstable (ρ ≥ 1)"),
+                "paper_verdict": "stable" if cell["paper_spectral_radius"] < 1 else "unstable",
+            })
+    return rows
+
+
+COLUMNS = (("cell", "cell"), ("paper", "paper λ"), ("paper_rho", "paper |λ|max"), ("ours", "ours λ"),
+           ("rho", "ours ρ"), ("ci", "95 % CI of ρ"), ("pairs", "pairs"), ("falls", "falls"),
+           ("verdict", "verdict"))
+
+
+def report_markdown(record: dict) -> str:
+    s = record["settings"]
+    lines = [
+        "# Stability report: Table VI (return-map eigenvalues) beside the paper's",
+        "",
+        f"Torque-free period {s['window'][0]:g}–{s['window'][1]:g} s; pushes ±{s['push_force_n']:g} N on the "
+        f"torso for {s['push_duration_s']:g} s from {s['push_start_s']:g} s; {s['trials']} trials per cell "
+        f"(initial hip angle and speed within ±{100 * s['spread']:g} %, seed {s['seed']}); x* = mean undisturbed "
+        f"section state from touchdown {s['steady_from_step']} on; section state = (inter-leg hip angle, rate) "
+        "at touchdown.",
+        "",
+        "| " + " | ".join(h for _, h in COLUMNS) + " |",
+        "|" + "---|" * len(COLUMNS),
+    ]
+    for row in _rows(record):
+        lines.append("| " + " | ".join(row[k] for k, _ in COLUMNS) + " |")
+    lines += ["", "A cell is stable when the spectral radius ρ of its fitted return map is below 1; every cell "
+              "of the paper's Table VI is. ![Fig. 7](fig7_return_map.png)", ""]
+    jac = record.get("jacobian")
+    if jac:
+        lines += ["## Step-to-step Jacobian (finite differences in Drake) beside the regression", "",
+                  "| condition | Jacobian λ | ρ | regression ρ (undisturbed) |", "|---|---|---|---|"]
+        for condition in CONDITIONS:
+            if condition in jac:
+                j = jac[condition]
+                lines.append(f"| {CONDITION_NAMES[condition]} | {_eig_text(j['eigenvalues'])} | "
+                             f"{j['spectral_radius']:.3f} | "
+                             f"{record['cells'][condition]['undisturbed'].get('spectral_radius', float('nan')):.3f} |")
+        lines.append("")
+    v = record.get("versions", {})
+    lines.append(f"drake-biped {v.get('drake_biped', '?')} ({v.get('git_commit', '?')}), Drake {v.get('drake', '?')}.")
+    return "\n".join(lines) + "\n"
+
+
+def report_html(record: dict) -> str:
+    rows = _rows(record)
+    head = "".join(f"<th>{html.escape(h)}</th>" for _, h in COLUMNS)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(r[k])}</td>" for k, _ in COLUMNS) + "</tr>" for r in rows)
+    md = report_markdown(record).split("\n")
+    intro = html.escape(md[2])
+    return (
+        "<!doctype html><html><head><meta charset='utf-8'><title>drake-biped stability report</title>"
+        "<style>body{font-family:sans-serif;max-width:70em;margin:2em auto}table{border-collapse:collapse}"
+        "td,th{border:1px solid #bbb;padding:4px 8px;font-size:90%}</style></head><body>"
+        "<h1>Stability report: Table VI beside the paper's</h1>"
+        f"<p>{intro}</p><table><tr>{head}</tr>{body}</table>"
+        "<p>A cell is stable when the spectral radius ρ of its fitted return map is below 1.</p>"
+        "<img src='fig7_return_map.png' alt='Fig. 7' style='max-width:100%'>"
+        "</body></html>\n"
+    )
+
+
+def write_stability_outputs(record: dict, out: str | Path) -> list[Path]:
+    out = Path(out)
+    paths = [out / "fig7_return_map.png", out / "report.md", out / "report.html"]
+    fig7(record, paths[0])
+    paths[1].write_text(report_markdown(record))
+    paths[2].write_text(report_html(record))
+    return paths

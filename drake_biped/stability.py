@@ -1,0 +1,212 @@
+"""Pushes and Poincaré return maps (SPEC §6.2-6.3, Table VI, Fig. 7), on Dask.
+
+Six cells: the gait without and with a torque-free period, each undisturbed, pushed forward and pushed
+backward (20 N on the torso for 0.1 s, 0.4 s into the trial). Each cell runs `trials` episodes; trial 0
+starts from the paper's initiation, trial k > 0 from it with the initial hip angle and speed scaled by
+independent factors in [1 - spread, 1 + spread] (seeded), so that the cells hold different transients
+and the fit is not carried by one trajectory. Every touchdown gives a section state x_n = (inter-leg hip
+angle, its rate) (`StepRecord`); a cell's return map is fitted to the pairs of consecutive touchdowns of
+each trial (never across trials) about x* = the mean undisturbed steady section state of its condition
+(touchdowns from `steady_from_step` on, of the undisturbed cell of the same condition). A trial that
+falls gives the touchdowns it made.
+
+Nothing lost: each finished episode's result is written to OUT/episodes/ (atomically); a rerun with the
+same settings reads them back and runs only what is missing.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.params import EpisodeConfig, InitialConditions, ParameterError, Push, TorqueFreeWindow
+from drake_biped.versions import versions
+
+CONDITIONS = ("without", "with")
+DISTURBANCES = ("undisturbed", "forward", "backward")
+
+# Table VI of the paper: eigenvalues of the return map, as (real, imaginary) pairs.
+TABLE_VI_PAPER: dict[str, dict[str, list[tuple[float, float]]]] = {
+    "without": {"undisturbed": [(0.064, 0.101), (0.064, -0.101)],
+                "forward": [(0.318, 0.0), (-0.234, 0.0)],
+                "backward": [(0.378, 0.0), (-0.109, 0.0)]},
+    "with": {"undisturbed": [(-0.200, 0.0), (0.129, 0.0)],
+             "forward": [(0.140, 0.164), (0.140, -0.164)],
+             "backward": [(0.326, 0.0), (0.0345, 0.0)]},
+}
+
+
+@dataclass(frozen=True)
+class StabilitySettings:
+    """What a stability run depends on besides the episode configuration."""
+
+    window: tuple[float, float] = (0.2, 0.5)
+    trials: int = 8
+    push_force_n: float = 20.0
+    push_start_s: float = 0.4
+    push_duration_s: float = 0.1
+    spread: float = 0.15
+    steady_from_step: int = 6
+    bootstrap: int = 1000
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        t1, t2 = self.window
+        if not (math.isfinite(t1) and math.isfinite(t2) and 0 <= t1 < t2):
+            raise ParameterError(f"window {self.window!r}: need 0 <= t1 < t2 (a torque-free period to compare)")
+        if not isinstance(self.trials, int) or self.trials < 1:
+            raise ParameterError(f"trials {self.trials!r}: must be an integer >= 1")
+        if not (math.isfinite(self.push_force_n) and self.push_force_n > 0):
+            raise ParameterError(f"push_force_n {self.push_force_n!r}: must be > 0 (its sign is the direction)")
+        if not (self.push_start_s >= 0 and self.push_duration_s > 0):
+            raise ParameterError(f"push start {self.push_start_s!r} / duration {self.push_duration_s!r}: "
+                                 "need start >= 0 and duration > 0")
+        if not 0 <= self.spread < 0.5:
+            raise ParameterError(f"spread {self.spread!r}: must be in [0, 0.5)")
+        if not isinstance(self.steady_from_step, int) or self.steady_from_step < 1:
+            raise ParameterError(f"steady_from_step {self.steady_from_step!r}: must be an integer >= 1")
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["window"] = list(self.window)
+        return d
+
+
+def trial_initial(base: InitialConditions, seed: int, trial: int, spread: float) -> InitialConditions:
+    """Trial 0: `base`; trial k: its hip angle and speed scaled by seeded factors in [1 - spread, 1 + spread]."""
+    if trial == 0 or spread == 0:
+        return base
+    u = np.random.default_rng(np.random.SeedSequence([seed, trial])).uniform(-1.0, 1.0, 2)
+    return InitialConditions(hip_angle_rad=base.hip_angle_rad * (1 + spread * u[0]),
+                             speed_mps=base.speed_mps * (1 + spread * u[1]))
+
+
+def cell_configs(base: EpisodeConfig, settings: StabilitySettings) -> list[tuple[str, str, int, EpisodeConfig]]:
+    """(condition, disturbance, trial, config) for every episode of the six cells."""
+    out = []
+    signs = {"undisturbed": 0.0, "forward": 1.0, "backward": -1.0}
+    for condition in CONDITIONS:
+        window = TorqueFreeWindow(*settings.window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+        for kind in DISTURBANCES:
+            push = None
+            if signs[kind]:
+                push = Push(signs[kind] * settings.push_force_n, settings.push_start_s, settings.push_duration_s)
+            for k in range(settings.trials):
+                initial = trial_initial(base.initial, settings.seed, k, settings.spread)
+                out.append((condition, kind, k,
+                            base.replace(window=window, push=push, initial=initial, seed=settings.seed)))
+    return out
+
+
+def section_sequence(result: dict[str, Any], push_start_s: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """The trial's section states (n x 2) and, for each, the number of touchdowns since the push (0 = the
+    first touchdown after the push began; -1 before it; all -1 without a push)."""
+    steps = result["steps"]
+    x = np.array([[s["hip_angle_rad"], s["hip_rate_radps"]] for s in steps], dtype=float).reshape(-1, 2)
+    since = np.full(len(steps), -1, dtype=int)
+    if push_start_s is not None:
+        after = [i for i, s in enumerate(steps) if s["touchdown_time_s"] >= push_start_s]
+        if after:
+            since[after[0]:] = np.arange(len(steps) - after[0])
+    return x, since
+
+
+def equilibrium(results: list[dict[str, Any]], steady_from_step: int) -> np.ndarray:
+    """Mean section state of undisturbed trials over their touchdowns from `steady_from_step` on."""
+    rows = [np.array([[s["hip_angle_rad"], s["hip_rate_radps"]]
+                      for s in r["steps"] if s["index"] >= steady_from_step]).reshape(-1, 2) for r in results]
+    rows = [r for r in rows if len(r)]
+    if not rows:
+        raise ValueError(f"no undisturbed touchdowns from step {steady_from_step} on: walk further")
+    return np.vstack(rows).mean(axis=0)
+
+
+def analyse(results: dict[tuple[str, str, int], dict[str, Any]], settings: StabilitySettings) -> dict[str, Any]:
+    """Fit the six cells' return maps; the record that stability.json holds (besides settings and versions)."""
+    from analysis.return_map import complex_list, fit_return_map
+
+    cells: dict[str, dict[str, Any]] = {}
+    for condition in CONDITIONS:
+        undisturbed = [results[(condition, "undisturbed", k)] for k in range(settings.trials)]
+        x_star = equilibrium(undisturbed, settings.steady_from_step)
+        cells[condition] = {}
+        for kind in DISTURBANCES:
+            push_start = None if kind == "undisturbed" else settings.push_start_s
+            seqs, sinces, falls = [], [], 0
+            for k in range(settings.trials):
+                r = results[(condition, kind, k)]
+                falls += bool(r["fell"])
+                x, since = section_sequence(r, push_start)
+                if push_start is not None:
+                    x, since = x[since >= 0], since[since >= 0]
+                seqs.append(x)
+                sinces.append(since)
+            cell: dict[str, Any] = {"trials": settings.trials, "falls": falls,
+                                    "sequences": [s.tolist() for s in seqs],
+                                    "steps_since_push": [s.tolist() for s in sinces]}
+            try:
+                fit = fit_return_map(seqs, equilibrium=x_star, bootstrap=settings.bootstrap, seed=settings.seed)
+                cell.update(fit.to_dict())
+                cell["stable"] = bool(fit.spectral_radius < 1.0)
+            except ValueError as exc:
+                cell.update(error=str(exc), stable=None)
+            paper = np.array([complex(a, b) for a, b in TABLE_VI_PAPER[condition][kind]])
+            cell["paper_eigenvalues"] = complex_list(paper)
+            cell["paper_spectral_radius"] = float(np.max(np.abs(paper)))
+            cells[condition][kind] = cell
+        cells[condition]["equilibrium"] = x_star.tolist()
+    return cells
+
+
+def _result_path(out: Path, condition: str, kind: str, trial: int) -> Path:
+    return out / "episodes" / f"{condition}_{kind}_{trial}.json"
+
+
+def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, client,
+                  progress: Callable[[int, int], None] | None = None) -> dict[str, Any]:
+    """Run (or finish) the six cells on Dask and return the stability record."""
+    from distributed import as_completed
+
+    from drake_biped.learning import write_atomic
+    from drake_biped.parallel import episode_task
+
+    code = versions()  # recorded at the start: the code this process runs
+    (out / "episodes").mkdir(parents=True, exist_ok=True)
+    jobs = cell_configs(base, settings)
+    results: dict[tuple[str, str, int], dict[str, Any]] = {}
+    todo = []
+    for condition, kind, k, config in jobs:
+        path = _result_path(out, condition, kind, k)
+        cfg = config.to_dict()
+        if path.is_file():
+            saved = json.loads(path.read_text())
+            if saved.get("config") == cfg:
+                results[(condition, kind, k)] = saved
+                continue
+        todo.append((condition, kind, k, cfg))
+    total, done = len(jobs), len(results)
+    if progress:
+        progress(done, total)
+    futures = {client.submit(episode_task, cfg, pure=False): (c, kd, k) for c, kd, k, cfg in todo}
+    for future in as_completed(list(futures)):
+        key = futures[future]
+        r = future.result()
+        r.pop("task_wall_time_s", None)
+        r.pop("worker_peak_rss_mb", None)
+        write_atomic(_result_path(out, *key), r)
+        results[key] = r
+        done += 1
+        if progress:
+            progress(done, total)
+    return {
+        "settings": settings.to_dict(),
+        "config": base.to_dict(),
+        "versions": code,
+        "cells": analyse(results, settings),
+    }
