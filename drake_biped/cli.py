@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -358,6 +358,46 @@ def cmd_stability(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_push_margin(args: argparse.Namespace) -> int:
+    from drake_biped.learning import write_atomic
+    from drake_biped.parallel import check_scheduler_address, dask_client
+    from drake_biped.stability import push_margin
+    from drake_biped.versions import versions
+
+    config = _episode_config(args)
+    if args.policy is not None and args.t1 is not None:
+        raise ParameterError("give either --policy or --t1/--t2, not both")
+    if (args.t1 is None) != (args.t2 is None):
+        raise ParameterError("--t1 and --t2 go together: give both or neither")
+    window = _policy_window(Path(args.policy)) if args.policy else (
+        (args.t1, args.t2) if args.t1 is not None else (0.2, 0.5))
+    if window[1] <= window[0]:
+        raise ParameterError(f"--t1 {window[0]} --t2 {window[1]}: need t1 < t2")
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
+        if args.workers is not None:
+            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+    code = versions()
+    with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+        record = push_margin(config, window, client, max_force_n=args.max_force, tolerance_n=args.tolerance,
+                             progress=lambda n: print(f"round {n}", file=sys.stderr))
+    record.update(config=config.to_dict(), versions=code)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "push_margin.json", record)
+    lines = ["| | forward push survived (N) | backward push survived (N) |", "|---|---|---|"]
+    for condition, name in (("without", "without torque-free period"),
+                            ("with", f"with torque-free period {window[0]:g}-{window[1]:g} s")):
+        m = record["margins"][condition]
+        lines.append(f"| {name} | {m['forward']['survived_n']:.1f} | {m['backward']['survived_n']:.1f} |")
+    text = "\n".join(lines) + (f"\n\nPush for {record['push_duration_s']:g} s from {record['push_start_s']:g} s; "
+                               f"bisection to {args.tolerance:g} N, up to {args.max_force:g} N.\n")
+    (out / "push_margin.md").write_text(text)
+    print(text)
+    print(f"wrote {out}/push_margin.json, push_margin.md")
+    return 0
+
+
 def _steps(text: str) -> list[float]:
     parse = _number("positive")
     return [parse(t) for t in text.split(",")]
@@ -446,6 +486,19 @@ def build_parser() -> argparse.ArgumentParser:
     stab.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
     stab.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
     stab.set_defaults(func=cmd_stability)
+
+    pm = sub.add_parser("push-margin", help="the largest forward and backward push the gait survives, "
+                        "with and without a torque-free period (bisection, on Dask)")
+    _add_episode_options(pm)
+    pm.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
+    pm.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
+    pm.add_argument("--policy", default=None, help="a learning.json: use its learned torque-free period")
+    pm.add_argument("--max-force", type=_number("positive"), default=200.0, help="largest push tried (N); default 200")
+    pm.add_argument("--tolerance", type=_number("positive"), default=1.0, help="bisection tolerance (N); default 1")
+    pm.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
+    pm.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    pm.add_argument("--out", required=True, help="output folder")
+    pm.set_defaults(func=cmd_push_margin)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")

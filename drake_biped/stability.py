@@ -210,3 +210,63 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
         "versions": code,
         "cells": analyse(results, settings),
     }
+
+
+def survives(result: dict[str, Any], distance_m: float) -> bool:
+    return (not result["fell"]) and result["distance_m"] >= distance_m - 1e-6
+
+
+def push_margin(base: EpisodeConfig, window: tuple[float, float], client, max_force_n: float = 200.0,
+                tolerance_n: float = 1.0, push_start_s: float = 0.4, push_duration_s: float = 0.1,
+                progress: Callable[[int], None] | None = None) -> dict[str, Any]:
+    """The largest forward and backward push (N over `push_duration_s`, from `push_start_s`) after which the
+    gait still walks its distance, without and with the torque-free period `window`, by bisection.
+
+    Four bisections (condition x direction) advance together, one round of four episodes at a time. Each
+    assumes survival is monotonic in the force between 0 and `max_force_n`; the record keeps every episode
+    tried, so a non-monotonic case shows. The margin is the largest force that survived (its bracket's
+    upper end is the smallest that fell, or `max_force_n` if none fell)."""
+    from drake_biped.parallel import episode_task
+
+    if not (math.isfinite(max_force_n) and max_force_n > 0 and math.isfinite(tolerance_n) and tolerance_n > 0):
+        raise ParameterError(f"max force {max_force_n!r} and tolerance {tolerance_n!r} must be > 0")
+    distance = base.sim.distance_m
+    chains = {}
+    for condition in CONDITIONS:
+        w = TorqueFreeWindow(*window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+        for direction, sign in (("forward", 1.0), ("backward", -1.0)):
+            chains[(condition, direction)] = {"window": w, "sign": sign, "lo": 0.0, "hi": None, "tried": []}
+
+    def config(chain, force):
+        return base.replace(window=chain["window"],
+                            push=Push(chain["sign"] * force, push_start_s, push_duration_s)).to_dict()
+
+    # First round: the largest force; then bisect where it fell.
+    rounds = 0
+    pending = {key: max_force_n for key in chains}
+    while pending:
+        keys = list(pending)
+        futures = [client.submit(episode_task, config(chains[k], pending[k]), pure=False) for k in keys]
+        for key, result in zip(keys, client.gather(futures)):
+            c, force = chains[key], pending[key]
+            ok = survives(result, distance)
+            c["tried"].append({"force_n": force, "survived": ok, "distance_m": result["distance_m"],
+                               "fall_reason": result["fall_reason"]})
+            if ok:
+                c["lo"] = max(c["lo"], force)
+            else:
+                c["hi"] = force if c["hi"] is None else min(c["hi"], force)
+        rounds += 1
+        if progress:
+            progress(rounds)
+        pending = {}
+        for key, c in chains.items():
+            if c["hi"] is not None and c["hi"] - c["lo"] > tolerance_n:
+                pending[key] = 0.5 * (c["lo"] + c["hi"])
+    out: dict[str, Any] = {"window": list(window), "max_force_n": max_force_n, "tolerance_n": tolerance_n,
+                           "push_start_s": push_start_s, "push_duration_s": push_duration_s, "margins": {}}
+    for (condition, direction), c in chains.items():
+        out["margins"].setdefault(condition, {})[direction] = {
+            "survived_n": c["lo"], "fell_n": c["hi"], "impulse_ns": c["lo"] * push_duration_s,
+            "tried": c["tried"]}
+    return out

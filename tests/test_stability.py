@@ -135,3 +135,39 @@ def test_a_rerun_recomputes_nothing(tmp_path):
     assert {p.name: p.stat().st_mtime_ns for p in (tmp_path / "episodes").iterdir()} == stamps
     assert seen == [(6, 6)]
     assert json.dumps(first["cells"], sort_keys=True) == json.dumps(again["cells"], sort_keys=True)
+
+
+class _ThresholdClient:
+    """Stands in for a Dask client: an episode survives when its push is below a threshold per cell."""
+
+    def __init__(self, limits):
+        self.limits = limits
+        self.calls = 0
+
+    def submit(self, fn, config, pure=False):
+        self.calls += 1
+        force = config["push"]["force_n"]
+        cell = ("with" if config["window"]["end_s"] > config["window"]["start_s"] else "without",
+                "forward" if force > 0 else "backward")
+        fell = abs(force) > self.limits[cell]
+        return {"fell": fell, "distance_m": 2.0 if fell else 10.0, "fall_reason": "pitch" if fell else ""}
+
+    def gather(self, futures):
+        return futures
+
+
+def test_push_margin_brackets_each_threshold_within_the_tolerance():
+    from drake_biped.stability import push_margin
+
+    limits = {("without", "forward"): 37.3, ("without", "backward"): 61.0,
+              ("with", "forward"): 12.25, ("with", "backward"): 250.0}
+    client = _ThresholdClient(limits)
+    out = push_margin(EpisodeConfig(), (0.2, 0.5), client, max_force_n=200.0, tolerance_n=0.5)
+    for (condition, direction), limit in limits.items():
+        m = out["margins"][condition][direction]
+        if limit >= 200.0:
+            assert m["survived_n"] == 200.0 and m["fell_n"] is None
+        else:
+            assert m["survived_n"] <= limit < m["fell_n"] and m["fell_n"] - m["survived_n"] <= 0.5
+            assert m["impulse_ns"] == pytest.approx(0.1 * m["survived_n"])
+    assert client.calls <= 4 * (1 + math.ceil(math.log2(200 / 0.5)))
