@@ -244,9 +244,11 @@ def cmd_learn(args: argparse.Namespace) -> int:
         print(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
               f"{ev['learned_mean_cost_of_transport']:.3f}: {100 * ev['reduction']:.1f} % lower")
     run = json.loads((out / "run.json").read_text())
-    if run["episodes_per_min"]:
-        print(f"{run['episodes_this_run']} episodes in {run['learning_wall_s']:.0f} s "
-              f"({run['episodes_per_min']:.1f} episodes/min)")
+    this = run["sessions"][-1]
+    if this["episodes_per_min"]:
+        print(f"{this['episodes']} episodes in {this['learning_wall_s']:.0f} s "
+              f"({this['episodes_per_min']:.1f} episodes/min); the whole run so far: {run['episodes']} episodes, "
+              f"{run['learning_wall_s'] / 60:.1f} min of learning over {len(run['sessions'])} session(s)")
     print(f"wrote {out}/learning.json, fig4_reward.png, fig5_cmt.png, fig6_times.png, table_v.md")
     return 0
 

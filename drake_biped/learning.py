@@ -26,6 +26,7 @@ means no torque-free period, as in the paper.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 from collections.abc import Callable
@@ -237,6 +238,44 @@ def learning_record(settings: dict[str, Any], trials: list[Trial], evaluation: d
     }
 
 
+class SessionLog:
+    """OUT/run.json: one entry per session of a run (a first run and each resume): when, on what, how many
+    episodes in how long. Rewritten at most every `every_s` seconds while running, so a session that is
+    killed keeps its numbers. Wall times live here, not in learning.json, which a resume reproduces."""
+
+    def __init__(self, path: Path, workers: int | None, scheduler: str | None, every_s: float = 10.0):
+        self.path = path
+        self.sessions: list[dict[str, Any]] = []
+        if path.is_file():
+            try:
+                self.sessions = list(json.loads(path.read_text()).get("sessions", []))
+            except (json.JSONDecodeError, AttributeError):
+                self.sessions = []
+        self.t0 = time.perf_counter()
+        self.every_s = every_s
+        self._last = -math.inf
+        self.current = {"started": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "workers": workers,
+                        "scheduler": scheduler, "episodes": 0, "learning_wall_s": 0.0, "wall_s": 0.0,
+                        "episodes_per_min": None, "finished": False}
+
+    def update(self, episodes: int, learning: bool = True, finished: bool = False, force: bool = False) -> None:
+        now = time.perf_counter() - self.t0
+        self.current["episodes"] = episodes
+        if learning:
+            self.current["learning_wall_s"] = now
+            self.current["episodes_per_min"] = 60.0 * episodes / now if episodes and now > 0 else None
+        self.current["wall_s"] = now
+        self.current["finished"] = finished
+        if force or finished or now - self._last >= self.every_s:
+            self._last = now
+            done = [s for s in self.sessions] + [self.current]
+            episodes_all = sum(s["episodes"] for s in done)
+            wall_all = sum(s["learning_wall_s"] for s in done)
+            write_atomic(self.path, {
+                "sessions": done, "episodes": episodes_all, "learning_wall_s": wall_all,
+                "episodes_per_min": 60.0 * episodes_all / wall_all if episodes_all and wall_all > 0 else None})
+
+
 def learn(out: Path, settings: dict[str, Any], workers: int | None = None, scheduler: str | None = None,
           progress: bool = True) -> dict[str, Any]:
     """Run or resume the learning, evaluate, write learning.json, run.json, the figures and Table V."""
@@ -244,14 +283,19 @@ def learn(out: Path, settings: dict[str, Any], workers: int | None = None, sched
     from drake_biped.parallel import dask_client
 
     versions()  # the code version this process runs, recorded now (it is cached), not at the run's end
-    t0 = time.perf_counter()
+    out.mkdir(parents=True, exist_ok=True)
+    log = SessionLog(out / "run.json", workers, scheduler)
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=settings["trials"] * settings["episodes"], desc="learning", unit="episode")
+    start: list[int] = []
 
     def report(done: int, total: int, latest: float | None) -> None:
+        if not start:
+            start.append(done)
+        log.update(done - start[0])
         if bar is not None:
             bar.n = done
             bar.set_postfix_str("" if latest is None else f"latest mean reward {latest:.3f}", refresh=False)
@@ -260,17 +304,13 @@ def learn(out: Path, settings: dict[str, Any], workers: int | None = None, sched
     try:
         with dask_client(workers=workers, scheduler=scheduler) as client:
             trials, new = run_learning(out, settings, client, report)
-            t_learn = time.perf_counter() - t0
+            log.update(new, force=True)
             evaluation = evaluate(settings, trials, client)
     finally:
         if bar is not None:
             bar.close()
     record = learning_record(settings, trials, evaluation)
     write_atomic(out / "learning.json", record)
-    wall = time.perf_counter() - t0
-    write_atomic(out / "run.json", {
-        "wall_s": wall, "learning_wall_s": t_learn, "episodes_this_run": new,
-        "episodes_per_min": 60.0 * new / t_learn if new and t_learn > 0 else None,
-        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "workers": workers, "scheduler": scheduler})
+    log.update(new, learning=False, finished=True)
     learning_figures(record, out)
     return record

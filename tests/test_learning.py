@@ -110,3 +110,20 @@ def test_learn_refuses_bad_options(tmp_path, capsys, argv, match):
     with pytest.raises(SystemExit):
         main(["learn", "--out", str(tmp_path), *argv])
     assert match in capsys.readouterr().err
+
+
+def test_run_log_keeps_every_session_and_their_totals(tmp_path):
+    from drake_biped.learning import SessionLog
+
+    path = tmp_path / "run.json"
+    first = SessionLog(path, workers=2, scheduler=None, every_s=0.0)
+    first.update(5)  # a session that is then killed: its numbers are already on disk
+    second = SessionLog(path, workers=1, scheduler=None)
+    second.update(3, force=True)
+    second.update(3, learning=False, finished=True)
+    run = json.loads(path.read_text())
+    assert [s["episodes"] for s in run["sessions"]] == [5, 3]
+    assert [s["finished"] for s in run["sessions"]] == [False, True]
+    assert [s["workers"] for s in run["sessions"]] == [2, 1]
+    assert run["episodes"] == 8
+    assert run["learning_wall_s"] == pytest.approx(sum(s["learning_wall_s"] for s in run["sessions"]))
