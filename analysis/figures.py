@@ -230,15 +230,25 @@ def _learning_figures(record: dict, out: Path) -> list[Path]:
     fig.savefig(paths[-1], dpi=120)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11.5, 3.8), sharey=True)
     for key, color, name in (("1", "C0", "t̄1 (start)"), ("2", "C1", "t̄2 (end)")):
         ax.plot(ep, _moving_average(np.nanmean(a[f"t{key}"], axis=0), window), color=color, lw=0.8, alpha=0.5,
                 label=f"sampled t{key}, {window}-episode moving average")
         ax.plot(ep, np.nanmean(a[f"mean_t{key}"], axis=0), color=color, lw=2, label=f"policy mean {name}")
     ax.set_xlabel("episode")
     ax.set_ylabel("time after step start (s)")
-    ax.set_title("Fig. 6: torque-free start and end times (mean over trials)")
+    ax.set_title("Fig. 6: torque-free start and end times (mean over trials)", fontsize=10)
     ax.legend(fontsize=7)
+    # Each trial's policy: a mean over trials can hide trials that learned different things.
+    for k, trial in enumerate(record["trials"]):
+        color = f"C{k % 10}"
+        m1, m2 = a["mean_t1"][k], a["mean_t2"][k]
+        ax2.plot(ep, m1, color=color, lw=1.2, label=f"trial {trial['trial']}: t̄1")
+        ax2.plot(ep, m2, color=color, lw=1.2, ls="--", label=f"trial {trial['trial']}: t̄2")
+        ax2.fill_between(ep, m1, m2, where=m2 > m1, color=color, alpha=0.15, lw=0)
+    ax2.set_xlabel("episode")
+    ax2.set_title("each trial's policy mean (shaded: a torque-free period; none where t̄2 ≤ t̄1)", fontsize=9)
+    ax2.legend(fontsize=6, ncol=2)
     fig.tight_layout()
     paths.append(out / "fig6_times.png")
     fig.savefig(paths[-1], dpi=120)
