@@ -49,7 +49,8 @@ Q_PREV = 12  # 6 joint angles at the previous update
 TAU = 18  # 6 torques held since the previous update (N*m), a copy of the actuation group
 POSITIVE_WORK = 24  # 6 per-joint integrals of max(tau * omega, 0) dt (J)
 SIGNED_WORK = 30  # 6 per-joint integrals of tau * omega dt (J)
-N_STATE = 36
+PREV_CLEARANCE = 36  # the swing foot's clearance at the previous update (m), to place a touchdown in time
+N_STATE = 37
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
 TOUCHDOWN_FIELDS = ("time_s", "hip_angle_rad", "hip_rate_radps", "stance_right", "com_x_m")
@@ -94,6 +95,7 @@ class CpgWalkingController(LeafSystem):
         initial[STANCE_RIGHT] = 1.0 if initial_stance_right else 0.0
         initial[LIFTOFF_ANGLE] = initial_liftoff_angle
         initial[TARGET_X] = math.inf
+        initial[PREV_CLEARANCE] = math.inf
         self._torque_group = self.DeclareDiscreteState(6)
         self._state_group = self.DeclareDiscreteState(BasicVector(initial))
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
@@ -192,13 +194,25 @@ class CpgWalkingController(LeafSystem):
         ground = self._ground
         clearance = min(swing.heel_z - ground.height(swing.heel_x), swing.toe_z - ground.height(swing.toe_x))
         advance = swing.ankle_x - stance.ankle_x
+        c_prev = s[PREV_CLEARANCE]
+        s[PREV_CLEARANCE] = clearance
         if gait.is_touchdown(g, time_in_step, clearance, advance, s[GAMMA]):
             stance_right = not stance_right
             st_i, sw_i = sw_i, st_i
             stance, swing = swing, stance
             n = int(s[STEP_COUNT])
             if n < self._capacity:
-                row = (t + self._state_lag, q[st_i] - q[sw_i], v[st_i] - v[sw_i], 1.0 if stance_right else 0.0, com_x)
+                # The section state at the moment the clearance crossed the touchdown height, linearly
+                # between this update and the previous one (when the crossing is what confirmed the
+                # touchdown): without it, section states would be quantised by the control period
+                # (rate x period, ~3 mrad), which finite-difference studies of the step map cannot bear.
+                back = 0.0
+                thr = g.touchdown_height_m
+                if math.isfinite(c_prev) and c_prev > thr >= clearance:
+                    back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * self._dt
+                rate = v[st_i] - v[sw_i]
+                row = (t + self._state_lag - back, q[st_i] - q[sw_i] - back * rate, rate,
+                       1.0 if stance_right else 0.0, com_x)
                 td = discrete_state.get_mutable_vector(self._touchdown_group)
                 for k in range(_TD):
                     td.SetAtIndex(n * _TD + k, row[k])
@@ -206,6 +220,7 @@ class CpgWalkingController(LeafSystem):
             s[STEP_START] = t
             s[LIFTOFF_ANGLE] = swing.thigh_angle
             s[STEP_COUNT] = n + 1.0
+            s[PREV_CLEARANCE] = math.inf  # the next swing foot's clearance is not yet known
             s[GAMMA] = 0.0
             s[INTEGRAL] = 0.0
             time_in_step = 0.0

@@ -37,17 +37,29 @@ def test_replay_rejects_a_malformed_log():
 
 
 def test_touchdown_records_are_the_logged_section_states(short_walk):
-    """Each recorded touchdown equals the logged plant state at its time: inter-leg angle and rate
-    (leading minus trailing thigh) and the centre of mass."""
+    """Each recorded touchdown is the logged plant state of the update that confirmed it (inter-leg angle
+    and rate, leading minus trailing thigh; the centre of mass), carried back to the moment the swing
+    foot's clearance crossed the touchdown height, within the last control period."""
     T = short_walk.trajectory
+    dt = _config().sim.control_period_s
     assert len(short_walk.steps) >= 3
+    backs = []
     for step in short_walk.steps:
-        i = int(np.flatnonzero(np.isclose(T["time"], step.touchdown_time_s, rtol=0, atol=1e-9))[0])
+        i = int(np.flatnonzero(T["time"] >= step.touchdown_time_s - 1e-9)[0])
+        back = T["time"][i] - step.touchdown_time_s
+        assert 0.0 <= back < dt
+        backs.append(back)
         st, sw = (6, 3) if step.stance_leg == "right" else (3, 6)
-        assert step.hip_angle_rad == pytest.approx(T["positions"][i, st] - T["positions"][i, sw], abs=1e-12)
-        assert step.hip_rate_radps == pytest.approx(T["velocities"][i, st] - T["velocities"][i, sw], abs=1e-9)
+        angle = T["positions"][:, st] - T["positions"][:, sw]
+        rate = T["velocities"][i, st] - T["velocities"][i, sw]
+        assert step.hip_rate_radps == pytest.approx(rate, abs=1e-9)
+        assert step.hip_angle_rad == pytest.approx(angle[i] - back * rate, abs=1e-12)
+        # between the two logged states it was interpolated from (the leg rates are smooth over 1 ms)
+        lo, hi = sorted((angle[i - 1], angle[i]))
+        assert lo - 1e-6 <= step.hip_angle_rad <= hi + 1e-6
         assert step.com_x_m == pytest.approx(center_of_mass(T["positions"][i])[0], abs=1e-12)
         assert T["stance_right"][i] == (1.0 if step.stance_leg == "right" else 0.0)
+    assert max(backs) > 0.0  # the crossing is placed inside the control period, not on its grid
 
 
 def test_episode_ends_at_the_update_that_walks_the_distance(short_walk):
