@@ -117,14 +117,22 @@ def report_markdown(record: dict) -> str:
               "of the paper's Table VI is. ![Fig. 7](fig7_return_map.png)", ""]
     jac = record.get("jacobian")
     if jac:
-        lines += ["## Step-to-step Jacobian (finite differences in Drake) beside the regression", "",
-                  "| condition | Jacobian λ | ρ | regression ρ (undisturbed) |", "|---|---|---|---|"]
+        lines += ["## Step-to-step Jacobian by finite differences in Drake, beside the regression", "",
+                  "Kicks of the swing hip 30 ms before touchdown 8 (angle ε, rate 10ε, 16 directions); J by least "
+                  "squares from the measured Δx_n, Δx_n+1. The residual is the part of Δx_n+1 that J does not "
+                  "explain: the controller runs on a 1 ms grid, so the step map has small jumps, and where they "
+                  "are as large as the linear response J is not identifiable at that kick size.", "",
+                  "| condition | kick ε (rad) | λ | ρ | residual | regression ρ (undisturbed) |",
+                  "|---|---|---|---|---|---|"]
         for condition in CONDITIONS:
-            if condition in jac:
-                j = jac[condition]
-                lines.append(f"| {CONDITION_NAMES[condition]} | {_eig_text(j['eigenvalues'])} | "
-                             f"{j['spectral_radius']:.3f} | "
-                             f"{record['cells'][condition]['undisturbed'].get('spectral_radius', float('nan')):.3f} |")
+            reg = record["cells"][condition]["undisturbed"].get("spectral_radius")
+            for j in jac.get(condition, []):
+                if "error" in j:
+                    lines.append(f"| {CONDITION_NAMES[condition]} | {j['angle_rad']:g} | {j['error']} | | | |")
+                    continue
+                lines.append(f"| {CONDITION_NAMES[condition]} | {j['angle_rad']:g} | {_eig_text(j['eigenvalues'])} | "
+                             f"{j['spectral_radius']:.3f} | {100 * j['relative_residual']:.0f} % | "
+                             f"{'—' if reg is None else f'{reg:.3f}'} |")
         lines.append("")
     v = record.get("versions", {})
     lines.append(f"drake-biped {v.get('drake_biped', '?')} ({v.get('git_commit', '?')}), Drake {v.get('drake', '?')}.")
@@ -145,8 +153,22 @@ def report_html(record: dict) -> str:
         f"<p>{intro}</p><table><tr>{head}</tr>{body}</table>"
         "<p>A cell is stable when the spectral radius ρ of its fitted return map is below 1.</p>"
         "<img src='fig7_return_map.png' alt='Fig. 7' style='max-width:100%'>"
+        + _jacobian_html(record) +
         "</body></html>\n"
     )
+
+
+def _jacobian_html(record: dict) -> str:
+    md = report_markdown(record)
+    if "## Step-to-step Jacobian" not in md:
+        return ""
+    part = md.split("## Step-to-step Jacobian", 1)[1].split("\ndrake-biped ", 1)[0]
+    rows = [line for line in part.splitlines() if line.startswith("|") and not line.startswith("|---")]
+    text = [line for line in part.splitlines()[1:] if line and not line.startswith("|")]
+    cells = lambda line, tag: "".join(f"<{tag}>{html.escape(c.strip())}</{tag}>" for c in line.strip("|").split("|"))  # noqa: E731
+    table = "<tr>" + cells(rows[0], "th") + "</tr>" + "".join("<tr>" + cells(r, "td") + "</tr>" for r in rows[1:])
+    return ("<h2>Step-to-step Jacobian by finite differences in Drake, beside the regression</h2>"
+            f"<p>{html.escape(' '.join(text))}</p><table>{table}</table>")
 
 
 def write_stability_outputs(record: dict, out: str | Path) -> list[Path]:

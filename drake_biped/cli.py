@@ -11,8 +11,6 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from drake_biped.params import (
     EpisodeConfig,
     Ground,
@@ -302,17 +300,22 @@ def cmd_landscape(args: argparse.Namespace) -> int:
 
 
 def _policy_window(path: Path) -> tuple[float, float]:
-    """The learned torque-free period of a learning run: the mean of its trials' final policy means."""
+    """The learned torque-free period of a learning run: of its trials whose final policy mean has a
+    window (t̄2 > t̄1) and walked the distance in the evaluation, the one with the lowest C_mt. (A mean over
+    trials would blend trials that learned a window with trials that learned none.)"""
     if not path.is_file():
         raise ParameterError(f"--policy: no such file: {path}")
     try:
-        means = np.array([t["final_mean"] for t in json.loads(path.read_text())["trials"]], dtype=float)
+        learned = json.loads(path.read_text())["evaluation"]["learned"]
+        rows = [(float(r["cost_of_transport"]), max(0.0, float(r["t1"])), max(0.0, float(r["t2"])))
+                for r in learned if not r["fell"] and r["cost_of_transport"] is not None]
     except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
-        raise ParameterError(f"--policy {path}: not a learning.json ({exc})") from None
-    t1, t2 = (max(0.0, float(x)) for x in means.mean(axis=0))
-    if t2 <= t1:
-        raise ParameterError(f"--policy {path}: the learned policy has no torque-free period "
-                             f"(mean t1 {t1:.3f} s >= t2 {t2:.3f} s); give --t1 and --t2")
+        raise ParameterError(f"--policy {path}: not a learning.json with an evaluation ({exc})") from None
+    rows = [r for r in rows if r[2] > r[1]]
+    if not rows:
+        raise ParameterError(f"--policy {path}: no trial learned a torque-free period that walks "
+                             "(every final mean has t2 <= t1); give --t1 and --t2")
+    _, t1, t2 = min(rows)
     return t1, t2
 
 
@@ -352,7 +355,7 @@ def cmd_stability(args: argparse.Namespace) -> int:
         with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
             record = run_stability(out, config, settings, client, progress)
     finally:
-        bar.close()
+        bar.close()  # (the finite-difference Jacobian's 102 episodes follow the cells, without a bar)
     write_atomic(out / "stability.json", record)
     write_stability_outputs(record, out)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
@@ -479,7 +482,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_episode_options(stab)
     stab.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
     stab.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
-    stab.add_argument("--policy", default=None, help="a learning.json: use its learned torque-free period")
+    stab.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
+                      "(the trial with a window and the lowest C_mt)")
     stab.add_argument("--trials", type=_count, default=8, help="trials per cell (default 8)")
     stab.add_argument("--push", type=_number("positive"), default=20.0, help="push force (N); default 20")
     stab.add_argument("--spread", type=_number("nonnegative"), default=0.15,
@@ -494,7 +498,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_episode_options(pm)
     pm.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
     pm.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
-    pm.add_argument("--policy", default=None, help="a learning.json: use its learned torque-free period")
+    pm.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
+                      "(the trial with a window and the lowest C_mt)")
     pm.add_argument("--max-force", type=_number("positive"), default=200.0, help="largest push tried (N); default 200")
     pm.add_argument("--tolerance", type=_number("positive"), default=1.0, help="bisection tolerance (N); default 1")
     pm.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")

@@ -137,6 +137,24 @@ class DiagramCache:
 _CACHE = DiagramCache()
 
 
+@dataclass(frozen=True)
+class Kick:
+    """An instantaneous change of the swing hip's angle (rad) and rate (rad/s) at time_s, as the plant's
+    state is found then: a perturbation for finite-difference studies of the step-to-step map (the swing
+    leg is in the air, so no contact is broken). Not part of an EpisodeConfig: a tool, not a scenario."""
+
+    time_s: float
+    hip_angle_rad: float = 0.0
+    hip_rate_radps: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("time_s", "hip_angle_rad", "hip_rate_radps"):
+            if not math.isfinite(getattr(self, name)):
+                raise ValueError(f"Kick.{name} must be finite, got {getattr(self, name)!r}")
+        if self.time_s <= 0:
+            raise ValueError(f"Kick.time_s must be > 0, got {self.time_s!r}")
+
+
 def simulate(
     config: EpisodeConfig,
     meshcat=None,
@@ -144,6 +162,7 @@ def simulate(
     record: bool = False,
     log_period_s: float | None = None,
     cache: DiagramCache | None = _CACHE,
+    kick: Kick | None = None,
 ) -> tuple[BipedDiagram, Simulator, str, float]:
     """Run one episode; return the diagram, the simulator, the termination reason and the wall time.
 
@@ -189,6 +208,18 @@ def simulate(
     simulator.Initialize()
     wall0 = time.perf_counter()
     try:
+        if kick is not None and kick.time_s < config.sim.max_time_s:
+            simulator.AdvanceTo(kick.time_s)
+            s = ctrl_ctx.get_discrete_state(group)
+            if s.GetAtIndex(ctl.FALL) == 0.0 and s.GetAtIndex(ctl.DONE) == 0.0:
+                swing = "left_hip" if s.GetAtIndex(ctl.STANCE_RIGHT) > 0.5 else "right_hip"
+                i = 3 + JOINT_NAMES.index(swing)
+                q = parts.plant.GetPositions(plant_ctx).copy()
+                v = parts.plant.GetVelocities(plant_ctx).copy()
+                q[i] += kick.hip_angle_rad
+                v[i] += kick.hip_rate_radps
+                parts.plant.SetPositions(plant_ctx, q)
+                parts.plant.SetVelocities(plant_ctx, v)
         simulator.AdvanceTo(config.sim.max_time_s)
         s = ctrl_ctx.get_discrete_state(group)
         reason = "fall" if s.GetAtIndex(ctl.FALL) != 0.0 else ("distance" if s.GetAtIndex(ctl.DONE) else "time limit")
@@ -204,15 +235,16 @@ def run_episode(
     record_trajectory: bool = False,
     progress: Callable[[float, float], None] | None = None,
     cache: DiagramCache | None = _CACHE,
+    kick: Kick | None = None,
 ) -> EpisodeResult:
-    """Walk one episode and summarise it (see EpisodeResult). `cache`: see simulate().
+    """Walk one episode and summarise it (see EpisodeResult). `cache`, `kick`: see simulate() and Kick.
 
     The episode ends at the control update that detects a fall or the distance walked; its duration,
     distance and work are those of the plant state that update read (see controller "Timing").
     """
     config = config or EpisodeConfig()
     parts, simulator, reason, wall = simulate(
-        config, meshcat=meshcat, progress=progress, record=record_trajectory, cache=cache
+        config, meshcat=meshcat, progress=progress, record=record_trajectory, cache=cache, kick=kick
     )
     context = simulator.get_context()
     ctrl_ctx = parts.controller.GetMyContextFromRoot(context)

@@ -168,9 +168,14 @@ def _result_path(out: Path, condition: str, kind: str, trial: int) -> Path:
     return out / "episodes" / f"{condition}_{kind}_{trial}.json"
 
 
+JACOBIAN_KICKS_RAD = (0.005, 0.01, 0.02)  # swing-hip angle kicks; rate kicks are 10x (rad/s)
+
+
 def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, client,
-                  progress: Callable[[int, int], None] | None = None) -> dict[str, Any]:
-    """Run (or finish) the six cells on Dask and return the stability record."""
+                  progress: Callable[[int, int], None] | None = None,
+                  jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD) -> dict[str, Any]:
+    """Run (or finish) the six cells on Dask, then the finite-difference Jacobian of each condition's step
+    map at each kick size, and return the stability record. Finished parts are read back on a rerun."""
     from distributed import as_completed
 
     from drake_biped.learning import write_atomic
@@ -204,11 +209,31 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
         done += 1
         if progress:
             progress(done, total)
+    jacobian: dict[str, list[dict[str, Any]]] = {}
+    for condition in CONDITIONS:
+        window = TorqueFreeWindow(*settings.window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+        config = base.replace(window=window, seed=settings.seed)
+        jacobian[condition] = []
+        for size in jacobian_kicks:
+            path = out / "episodes" / f"jacobian_{condition}_{size:g}.json"
+            if path.is_file():
+                saved = json.loads(path.read_text())
+                if saved.get("config") == config.to_dict():
+                    jacobian[condition].append(saved["jacobian"])
+                    continue
+            try:
+                fd = finite_difference_jacobian(config, client, angle_rad=size, rate_radps=10 * size,
+                                                seed=settings.seed)
+            except (RuntimeError, ParameterError) as exc:
+                fd = {"angle_rad": size, "rate_radps": 10 * size, "error": str(exc)}
+            write_atomic(path, {"config": config.to_dict(), "jacobian": fd})
+            jacobian[condition].append(fd)
     return {
         "settings": settings.to_dict(),
         "config": base.to_dict(),
         "versions": code,
         "cells": analyse(results, settings),
+        "jacobian": jacobian,
     }
 
 
@@ -270,3 +295,91 @@ def push_margin(base: EpisodeConfig, window: tuple[float, float], client, max_fo
             "survived_n": c["lo"], "fell_n": c["hi"], "impulse_ns": c["lo"] * push_duration_s,
             "tried": c["tried"]}
     return out
+
+
+def kicked_task(config: dict[str, Any], kick: dict[str, float] | None) -> dict[str, Any]:
+    """Dask task: one episode with an optional swing-hip kick (drake_biped.episode.Kick)."""
+    from drake_biped.episode import Kick, run_episode
+
+    return run_episode(EpisodeConfig.from_dict(config), kick=Kick(**kick) if kick else None).to_dict()
+
+
+def _section(result: dict[str, Any], index: int) -> np.ndarray | None:
+    for s in result["steps"]:
+        if s["index"] == index:
+            return np.array([s["hip_angle_rad"], s["hip_rate_radps"]])
+    return None
+
+
+def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle_rad: float = 0.005,
+                               rate_radps: float = 0.05, lead_s: float = 0.03, kicks: int = 16,
+                               seed: int = 0) -> dict[str, Any]:
+    """The step-to-step Jacobian of the gait at touchdown `step`, by finite differences in Drake.
+
+    The unperturbed walk gives touchdown n = `step` at T_n. `kicks` more walks kick the swing hip `lead_s`
+    before T_n, while the swing foot is still in the air, by (a·angle_rad, b·rate_radps) with (a, b) evenly
+    spread around the unit circle (a random phase from `seed`). Each kick moves the section state at
+    touchdown n (Δx_n, measured: the controller's touchdown logic forms the section as it always does) and
+    at touchdown n + 1 (Δx_n+1); J is the least-squares solution of Δx_n+1 = J Δx_n over the kicks.
+
+    Least squares rather than two central differences: the controller is a sampled-data system (the step
+    clock, phase reset and torque-free window start on the 1 ms update grid), so the step map carries small
+    jumps where a touchdown moves across an update; a pair of kicks can land on either side of one, and many
+    kicks average them out, as the regression does with pushes. The residual says how large they are.
+    """
+    from drake_biped.parallel import episode_task
+
+    if not isinstance(step, int) or step < 2:
+        raise ParameterError(f"step {step!r}: must be an integer >= 2")
+    if not (angle_rad > 0 and rate_radps > 0 and lead_s > 0):
+        raise ParameterError("angle_rad, rate_radps and lead_s must be > 0")
+    if not isinstance(kicks, int) or kicks < 3:
+        raise ParameterError(f"kicks {kicks!r}: must be an integer >= 3")
+    cfg = base.to_dict()
+    ref = client.submit(episode_task, cfg, pure=False).result()
+    x0, y0 = _section(ref, step), _section(ref, step + 1)
+    if x0 is None or y0 is None:
+        raise ParameterError(f"the unperturbed walk has no touchdowns {step} and {step + 1}: walk further "
+                             f"(it made {len(ref['steps'])}, fell={ref['fell']})")
+    times = {s["index"]: s["touchdown_time_s"] for s in ref["steps"]}
+    t_kick = times[step] - lead_s
+    if t_kick <= times[step - 1]:
+        raise ParameterError(f"lead_s {lead_s!r} reaches back past touchdown {step - 1}")
+    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi)
+    angles = phase + 2 * np.pi * np.arange(kicks) / kicks
+    plan = [{"time_s": t_kick, "hip_angle_rad": float(np.cos(a) * angle_rad),
+             "hip_rate_radps": float(np.sin(a) * rate_radps)} for a in angles]
+    runs = client.gather([client.submit(kicked_task, cfg, k, pure=False) for k in plan])
+    dx, dy, lost = [], [], 0
+    for r in runs:
+        x, y = _section(r, step), _section(r, step + 1)
+        if x is None or y is None:
+            lost += 1
+            continue
+        dx.append(x - x0)
+        dy.append(y - y0)
+    if len(dx) < 3:
+        raise RuntimeError(f"{lost} of {kicks} kicks ended the walk before touchdown {step + 1}: use smaller kicks")
+    dx, dy = np.array(dx), np.array(dy)
+    jac_t, *_ = np.linalg.lstsq(dx, dy, rcond=None)
+    jac = jac_t.T
+    res = dy - dx @ jac_t
+    eig = np.linalg.eigvals(jac)
+    from analysis.return_map import complex_list
+
+    return {
+        "jacobian": jac.tolist(),
+        "eigenvalues": complex_list(eig),
+        "spectral_radius": float(np.max(np.abs(eig))),
+        "section_state": x0.tolist(),
+        "next_section_state": y0.tolist(),
+        "step": step,
+        "kick_time_s": t_kick,
+        "angle_rad": angle_rad,
+        "rate_radps": rate_radps,
+        "lead_s": lead_s,
+        "kicks": kicks,
+        "kicks_lost": lost,
+        "relative_residual": float(np.linalg.norm(res) / max(np.linalg.norm(dy), 1e-300)),
+        "dx_condition_number": float(np.linalg.cond(dx)),
+    }

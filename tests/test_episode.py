@@ -156,3 +156,19 @@ def test_push_changes_the_airborne_robot_momentum_by_exactly_its_impulse():
     assert p[0.4] - p[0.3] == pytest.approx(0.0, abs=0.02)
     assert p[0.5] - p[0.4] == pytest.approx(2.0, abs=0.02)
     assert p[0.6] - p[0.5] == pytest.approx(0.0, abs=0.02)
+
+
+def test_a_kick_changes_the_swing_hip_and_nothing_else_changes_without_one():
+    from drake_biped.episode import Kick
+
+    config = EpisodeConfig(sim=SimulationParams(distance_m=2.0, max_time_s=8.0))
+    plain = run_episode(config)
+    assert run_episode(config, kick=Kick(time_s=100.0)).steps == plain.steps  # after the end: no kick
+    kicked = run_episode(config, kick=Kick(time_s=1.0, hip_rate_radps=0.3))
+    before = [s for s in plain.steps if s.touchdown_time_s < 1.0]
+    assert kicked.steps[: len(before)] == before  # identical up to the kick
+    assert kicked.steps[len(before)].hip_rate_radps != plain.steps[len(before)].hip_rate_radps
+    with pytest.raises(ValueError, match="time_s"):
+        Kick(time_s=0.0)
+    with pytest.raises(ValueError, match="finite"):
+        Kick(time_s=1.0, hip_angle_rad=float("nan"))

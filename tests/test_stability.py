@@ -131,7 +131,9 @@ def test_a_rerun_recomputes_nothing(tmp_path):
         first = run_stability(tmp_path, base, s, client)
         stamps = {p.name: p.stat().st_mtime_ns for p in (tmp_path / "episodes").iterdir()}
         again = run_stability(tmp_path, base, s, client, progress=lambda d, t: seen.append((d, t)))
-    assert len(stamps) == 6
+    assert len(stamps) == 6 + 6  # six cells' episodes, and the Jacobian at 3 kick sizes per condition
+    # 1.2 m is too short for the Jacobian at touchdown 8: recorded as such, not a crash
+    assert all("walk further" in j["error"] for c in ("without", "with") for j in first["jacobian"][c])
     assert {p.name: p.stat().st_mtime_ns for p in (tmp_path / "episodes").iterdir()} == stamps
     assert seen == [(6, 6)]
     assert json.dumps(first["cells"], sort_keys=True) == json.dumps(again["cells"], sort_keys=True)
@@ -171,3 +173,65 @@ def test_push_margin_brackets_each_threshold_within_the_tolerance():
             assert m["survived_n"] <= limit < m["fell_n"] and m["fell_n"] - m["survived_n"] <= 0.5
             assert m["impulse_ns"] == pytest.approx(0.1 * m["survived_n"])
     assert client.calls <= 4 * (1 + math.ceil(math.log2(200 / 0.5)))
+
+
+class _Done:
+    def __init__(self, value):
+        self.value = value
+
+    def result(self):
+        return self.value
+
+
+class _LinearStepClient:
+    """Stands in for a Dask client running walks whose touchdown 8 responds to a swing-hip kick through M
+    and whose touchdown 9 follows touchdown 8 through J (plus optional jumps)."""
+
+    def __init__(self, m, j, x0, y0, jump=0.0):
+        self.m, self.j, self.x0, self.y0, self.jump = m, j, x0, y0, jump
+        self.rng = np.random.default_rng(0)
+
+    def submit(self, fn, config, kick=None, pure=False):
+        d = np.zeros(2) if kick is None else self.m @ [kick["hip_angle_rad"], kick["hip_rate_radps"]]
+        x = self.x0 + d
+        y = self.y0 + self.j @ d + (self.jump * self.rng.standard_normal(2) if kick else 0.0)
+        steps = [{"index": 7, "touchdown_time_s": 5.6, "hip_angle_rad": 1.0, "hip_rate_radps": 3.0}]
+        steps += [{"index": i, "touchdown_time_s": t, "hip_angle_rad": float(s[0]), "hip_rate_radps": float(s[1])}
+                  for i, t, s in ((8, 6.4, x), (9, 7.2, y))]
+        return _Done({"steps": steps, "fell": False})
+
+    def gather(self, futures):
+        return [f.result() for f in futures]
+
+
+def test_finite_difference_jacobian_recovers_a_known_step_map():
+    from drake_biped.stability import finite_difference_jacobian
+
+    j_true = a_with([0.3 + 0.2j, 0.3 - 0.2j])
+    m = np.array([[0.8, 0.05], [-2.0, 0.9]])  # a kick moves both section coordinates
+    client = _LinearStepClient(m, j_true, np.array([0.98, 2.85]), np.array([0.98, 2.85]))
+    fd = finite_difference_jacobian(EpisodeConfig(), client, step=8, angle_rad=0.005, rate_radps=0.05)
+    np.testing.assert_allclose(fd["jacobian"], j_true, atol=1e-9)
+    assert fd["spectral_radius"] == pytest.approx(abs(0.3 + 0.2j), abs=1e-9)
+    assert fd["relative_residual"] < 1e-9 and fd["kicks_lost"] == 0
+    assert fd["kick_time_s"] == pytest.approx(6.4 - 0.03)
+    # Jumps as large as the response leave most of it unexplained, and the residual says so.
+    noisy = finite_difference_jacobian(EpisodeConfig(), _LinearStepClient(m, j_true, client.x0, client.y0, jump=0.01),
+                                       step=8, angle_rad=0.005, rate_radps=0.05)
+    assert noisy["relative_residual"] > 0.3
+
+
+def test_policy_option_takes_the_best_learned_window(tmp_path, capsys):
+    from drake_biped.cli import _policy_window, main
+
+    learned = [{"trial": 0, "t1": 0.5, "t2": 0.3, "cost_of_transport": 0.221, "fell": False},
+               {"trial": 1, "t1": 0.14, "t2": 0.30, "cost_of_transport": 0.144, "fell": False},
+               {"trial": 2, "t1": 0.08, "t2": 0.27, "cost_of_transport": 0.154, "fell": False},
+               {"trial": 3, "t1": 0.1, "t2": 0.8, "cost_of_transport": 0.1, "fell": True}]
+    path = tmp_path / "learning.json"
+    path.write_text(json.dumps({"evaluation": {"learned": learned}}))
+    assert _policy_window(path) == (0.14, 0.30)
+    path.write_text(json.dumps({"evaluation": {"learned": learned[:1]}}))
+    with pytest.raises(SystemExit):
+        main(["stability", "--policy", str(path), "--out", str(tmp_path / "s")])
+    assert "no trial learned a torque-free period" in capsys.readouterr().err
