@@ -69,6 +69,15 @@ def fig7(record: dict, path: str | Path) -> None:
     plt.close(fig)
 
 
+def _verdict(cell: dict) -> str:
+    falls = f"{cell['falls']} of {cell['trials']} trials fell"
+    if "error" in cell:
+        return ("not stable: " + falls + "; no fit") if cell["falls"] else "no fit: " + cell["error"]
+    if cell["falls"]:
+        return f"not stable: {falls} (ρ {cell['spectral_radius']:.2f} over their touchdowns before the fall)"
+    return "stable (ρ < 1)" if cell["stable"] else "unstable (ρ ≥ 1)"
+
+
 def _rows(record: dict) -> list[dict]:
     rows = []
     for condition in CONDITIONS:
@@ -85,8 +94,7 @@ def _rows(record: dict) -> list[dict]:
                 "ci": "—" if not ci else f"[{ci[0]:.3f}, {ci[1]:.3f}]",
                 "pairs": str(cell.get("n_pairs", 0)),
                 "falls": f"{cell['falls']}/{cell['trials']}",
-                "verdict": ("no fit: " + cell["error"]) if "error" in cell else
-                           ("stable (ρ < 1)" if cell["stable"] else "unstable (ρ ≥ 1)"),
+                "verdict": _verdict(cell),
                 "paper_verdict": "stable" if cell["paper_spectral_radius"] < 1 else "unstable",
             })
     return rows
@@ -113,8 +121,8 @@ def report_markdown(record: dict) -> str:
     ]
     for row in _rows(record):
         lines.append("| " + " | ".join(row[k] for k, _ in COLUMNS) + " |")
-    lines += ["", "A cell is stable when the spectral radius ρ of its fitted return map is below 1; every cell "
-              "of the paper's Table VI is. ![Fig. 7](fig7_return_map.png)", ""]
+    lines += ["", "A cell is stable when the spectral radius ρ of its fitted return map is below 1 and no trial "
+              "fell; every cell of the paper's Table VI is. ![Fig. 7](fig7_return_map.png)", ""]
     jac = record.get("jacobian")
     if jac:
         lines += ["## Step-to-step Jacobian by finite differences in Drake, beside the regression", "",
@@ -151,7 +159,7 @@ def report_html(record: dict) -> str:
         "td,th{border:1px solid #bbb;padding:4px 8px;font-size:90%}</style></head><body>"
         "<h1>Stability report: Table VI beside the paper's</h1>"
         f"<p>{intro}</p><table><tr>{head}</tr>{body}</table>"
-        "<p>A cell is stable when the spectral radius ρ of its fitted return map is below 1.</p>"
+        "<p>A cell is stable when the spectral radius ρ of its fitted return map is below 1 and no trial fell.</p>"
         "<img src='fig7_return_map.png' alt='Fig. 7' style='max-width:100%'>"
         + _jacobian_html(record) +
         "</body></html>\n"

@@ -153,7 +153,10 @@ def analyse(results: dict[tuple[str, str, int], dict[str, Any]], settings: Stabi
             try:
                 fit = fit_return_map(seqs, equilibrium=x_star, bootstrap=settings.bootstrap, seed=settings.seed)
                 cell.update(fit.to_dict())
-                cell["stable"] = bool(fit.spectral_radius < 1.0)
+                # Stable: the linearised return map contracts and no trial fell (a push that topples the
+                # robot is outside any linear map's reach, whatever the touchdowns before it say).
+                cell["spectral_radius_below_one"] = bool(fit.spectral_radius < 1.0)
+                cell["stable"] = bool(fit.spectral_radius < 1.0 and falls == 0)
             except ValueError as exc:
                 cell.update(error=str(exc), stable=None)
             paper = np.array([complex(a, b) for a, b in TABLE_VI_PAPER[condition][kind]])

@@ -235,3 +235,15 @@ def test_policy_option_takes_the_best_learned_window(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["stability", "--policy", str(path), "--out", str(tmp_path / "s")])
     assert "no trial learned a torque-free period" in capsys.readouterr().err
+
+
+def test_a_cell_whose_trials_fall_is_not_called_stable():
+    s = StabilitySettings(trials=3, bootstrap=0, steady_from_step=10)
+    maps = {c: {k: a_with([0.3, -0.1]) for k in ("undisturbed", "forward", "backward")} for c in ("without", "with")}
+    results = _fake_results(s, maps, np.array([0.98, 2.85]))
+    results[("with", "backward", 1)]["fell"] = True
+    cells = analyse(results, s)
+    assert cells["with"]["backward"]["spectral_radius_below_one"] and not cells["with"]["backward"]["stable"]
+    assert cells["with"]["forward"]["stable"]
+    md = report_markdown({"settings": s.to_dict(), "versions": {}, "cells": cells})
+    assert "not stable: 1 of 3 trials fell" in md
