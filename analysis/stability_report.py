@@ -48,6 +48,8 @@ def fig7(record: dict, path: str | Path) -> None:
             ax.axvline(0, color="0.85", lw=0.6)
             rho = cell.get("spectral_radius")
             title = f"{kind}: ρ = {rho:.3f}" if rho is not None else f"{kind}: no fit"
+            if cell["falls"]:
+                title += f"; {cell['falls']} of {cell['trials']} trials fell"
             ax.set_title(title, fontsize=9)
             if j == 0:
                 ax.set_ylabel(f"{CONDITION_NAMES[condition]}\nθ_(n+1) − θ* [mrad]", fontsize=8)

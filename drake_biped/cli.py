@@ -392,7 +392,7 @@ def cmd_push_margin(args: argparse.Namespace) -> int:
     write_atomic(out / "push_margin.json", record)
     lines = ["| | forward push survived (N) | backward push survived (N) |", "|---|---|---|"]
     for condition, name in (("without", "without torque-free period"),
-                            ("with", f"with torque-free period {window[0]:g}-{window[1]:g} s")):
+                            ("with", f"with torque-free period {window[0]:.3f}-{window[1]:.3f} s")):
         m = record["margins"][condition]
         lines.append(f"| {name} | {m['forward']['survived_n']:.1f} | {m['backward']['survived_n']:.1f} |")
     text = "\n".join(lines) + (f"\n\nPush for {record['push_duration_s']:g} s from {record['push_start_s']:g} s; "
