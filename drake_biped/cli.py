@@ -224,13 +224,9 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
 
 def cmd_learn(args: argparse.Namespace) -> int:
     from drake_biped.learning import learn, make_settings
-    from drake_biped.parallel import check_scheduler_address
 
     config = _episode_config(args)
-    if args.scheduler is not None:
-        check_scheduler_address(args.scheduler)
-        if args.workers is not None:
-            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+    _check_cluster_options(args)
     settings = make_settings(config, args.trials, args.episodes, args.seed if args.seed is not None else 0,
                              mean=tuple(args.initial_mean), variance=args.variance)
     out = Path(args.out)
@@ -319,27 +315,39 @@ def _policy_window(path: Path) -> tuple[float, float]:
     return t1, t2
 
 
-def cmd_stability(args: argparse.Namespace) -> int:
-    from analysis.stability_report import write_stability_outputs
-    from drake_biped.learning import write_atomic
-    from drake_biped.parallel import check_scheduler_address, dask_client
-    from drake_biped.stability import StabilitySettings, run_stability
-
-    config = _episode_config(args)
+def _chosen_window(args: argparse.Namespace) -> tuple[float, float]:
+    """The torque-free period to compare against none: --policy, or --t1/--t2, or 0.2-0.5 s."""
     if args.policy is not None and args.t1 is not None:
         raise ParameterError("give either --policy or --t1/--t2, not both")
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
     if args.policy is not None:
-        window = _policy_window(Path(args.policy))
-    elif args.t1 is not None:
-        window = (args.t1, args.t2)
-    else:
-        window = (0.2, 0.5)
+        return _policy_window(Path(args.policy))
+    if args.t1 is not None:
+        if args.t2 <= args.t1:
+            raise ParameterError(f"--t1 {args.t1} --t2 {args.t2}: need t1 < t2")
+        return args.t1, args.t2
+    return 0.2, 0.5
+
+
+def _check_cluster_options(args: argparse.Namespace) -> None:
+    from drake_biped.parallel import check_scheduler_address
+
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
         if args.workers is not None:
             raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+
+
+def cmd_stability(args: argparse.Namespace) -> int:
+    from analysis.stability_report import write_stability_outputs
+    from drake_biped.learning import write_atomic
+    from drake_biped.parallel import dask_client
+    from drake_biped.stability import StabilitySettings, run_stability
+
+    config = _episode_config(args)
+    window = _chosen_window(args)
+    _check_cluster_options(args)
     settings = StabilitySettings(window=window, trials=args.trials, push_force_n=args.push,
                                  spread=args.spread, seed=config.seed)
     out = Path(args.out)
@@ -365,23 +373,13 @@ def cmd_stability(args: argparse.Namespace) -> int:
 
 def cmd_push_margin(args: argparse.Namespace) -> int:
     from drake_biped.learning import write_atomic
-    from drake_biped.parallel import check_scheduler_address, dask_client
+    from drake_biped.parallel import dask_client
     from drake_biped.stability import push_margin
     from drake_biped.versions import versions
 
     config = _episode_config(args)
-    if args.policy is not None and args.t1 is not None:
-        raise ParameterError("give either --policy or --t1/--t2, not both")
-    if (args.t1 is None) != (args.t2 is None):
-        raise ParameterError("--t1 and --t2 go together: give both or neither")
-    window = _policy_window(Path(args.policy)) if args.policy else (
-        (args.t1, args.t2) if args.t1 is not None else (0.2, 0.5))
-    if window[1] <= window[0]:
-        raise ParameterError(f"--t1 {window[0]} --t2 {window[1]}: need t1 < t2")
-    if args.scheduler is not None:
-        check_scheduler_address(args.scheduler)
-        if args.workers is not None:
-            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+    window = _chosen_window(args)
+    _check_cluster_options(args)
     code = versions()
     with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
         record = push_margin(config, window, client, max_force_n=args.max_force, tolerance_n=args.tolerance,
