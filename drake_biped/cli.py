@@ -406,6 +406,18 @@ def _steps(text: str) -> list[float]:
     return [parse(t) for t in text.split(",")]
 
 
+def _add_window_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
+    p.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
+    p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
+                   "(the trial with a window and the lowest C_mt)")
+
+
+def _add_cluster_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
+    p.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="drake-biped", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -478,30 +490,22 @@ def build_parser() -> argparse.ArgumentParser:
     stab = sub.add_parser("stability", help="pushes and Poincare return maps with and without a torque-free "
                           "period (Table VI, Fig. 7), on Dask")
     _add_episode_options(stab)
-    stab.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
-    stab.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
-    stab.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
-                      "(the trial with a window and the lowest C_mt)")
+    _add_window_options(stab)
     stab.add_argument("--trials", type=_count, default=8, help="trials per cell (default 8)")
     stab.add_argument("--push", type=_number("positive"), default=20.0, help="push force (N); default 20")
     stab.add_argument("--spread", type=_number("nonnegative"), default=0.15,
                       help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
-    stab.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
-    stab.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    _add_cluster_options(stab)
     stab.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
     stab.set_defaults(func=cmd_stability)
 
     pm = sub.add_parser("push-margin", help="the largest forward and backward push the gait survives, "
                         "with and without a torque-free period (bisection, on Dask)")
     _add_episode_options(pm)
-    pm.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
-    pm.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
-    pm.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
-                      "(the trial with a window and the lowest C_mt)")
+    _add_window_options(pm)
     pm.add_argument("--max-force", type=_number("positive"), default=200.0, help="largest push tried (N); default 200")
     pm.add_argument("--tolerance", type=_number("positive"), default=1.0, help="bisection tolerance (N); default 1")
-    pm.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
-    pm.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    _add_cluster_options(pm)
     pm.add_argument("--out", required=True, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
 
