@@ -457,8 +457,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="time steps (s), comma-separated (default 0.00025,0.0005,0.001,0.002,0.005)")
     ts.add_argument("--reference", type=_number("positive"), default=0.0005, help="reference step (s), one of --steps")
     ts.add_argument("--distance", type=_number("positive"), default=10.0, help="walk this far (m); default 10")
-    ts.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
-    ts.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    _add_cluster_options(ts)
     ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
     ts.add_argument("--out", required=True, help="output folder")
     ts.set_defaults(func=cmd_time_step_study)
@@ -471,8 +470,7 @@ def build_parser() -> argparse.ArgumentParser:
                        metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
     learn.add_argument("--variance", type=_number("positive"), default=0.04,
                        help="the policy's variance per time (s^2); default 0.04 as in the paper")
-    learn.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
-    learn.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    _add_cluster_options(learn)
     learn.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
     learn.set_defaults(func=cmd_learn)
 
