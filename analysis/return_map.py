@@ -88,8 +88,9 @@ def section_pairs(sequences: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarr
     return np.vstack(xs), np.vstack(ys)
 
 
-def _lstsq_a(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
-    # Rows are pairs: dy ≈ dx Aᵀ.
+def least_squares_map(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """The matrix A minimising |dy - dx Aᵀ| (rows are pairs of deviations): A = Y Xᵀ (X Xᵀ)⁻¹ without
+    forming the inverse."""
     a_t, *_ = np.linalg.lstsq(dx, dy, rcond=None)
     return a_t.T
 
@@ -128,7 +129,7 @@ def fit_return_map(
     if np.linalg.matrix_rank(dx) < dim:
         raise ValueError("the section states do not span the state space (all deviations on a line): "
                          "the return map is not identifiable; perturb the gait or add runs")
-    a = _lstsq_a(dx, dy)
+    a = least_squares_map(dx, dy)
     eig = np.linalg.eigvals(a)
     res = dy - dx @ a.T
     total = float(np.sum((dy - dy.mean(axis=0)) ** 2))
@@ -141,7 +142,7 @@ def fit_return_map(
             idx = rng.integers(0, n, n)
             if np.linalg.matrix_rank(dx[idx]) < dim:
                 continue
-            radii.append(spectral_radius(_lstsq_a(dx[idx], dy[idx])))
+            radii.append(spectral_radius(least_squares_map(dx[idx], dy[idx])))
         if radii:
             tail = 100 * (1 - ci_level) / 2
             lo, hi = np.percentile(radii, [tail, 100 - tail])

@@ -107,16 +107,43 @@ COLUMNS = (("cell", "cell"), ("paper", "paper λ"), ("paper_rho", "paper |λ|max
            ("verdict", "verdict"))
 
 
-def report_markdown(record: dict) -> str:
+JACOBIAN_TITLE = "Step-to-step Jacobian by finite differences in Drake, beside the regression"
+JACOBIAN_TEXT = (
+    "Kicks of the swing hip 30 ms before touchdown 8 (angle ε, rate 10ε, 16 directions); J by least squares "
+    "from the measured Δx_n, Δx_n+1. The residual is the part of Δx_n+1 that J does not explain; where it is "
+    "large, the step map's linear response is as small as its scatter (most likely the jumps of a controller "
+    "on a 1 ms grid) and J is not identifiable at that kick size.")
+JACOBIAN_COLUMNS = ("condition", "kick ε (rad)", "λ", "ρ", "residual", "regression ρ (undisturbed)")
+
+
+def _jacobian_rows(record: dict) -> list[list[str]]:
+    rows = []
+    for condition, entries in (record.get("jacobian") or {}).items():
+        reg = record["cells"][condition]["undisturbed"].get("spectral_radius")
+        reg_text = "—" if reg is None else f"{reg:.3f}"
+        for j in entries:
+            if "error" in j:
+                rows.append([CONDITION_NAMES[condition], f"{j['angle_rad']:g}", j["error"], "", "", reg_text])
+            else:
+                rows.append([CONDITION_NAMES[condition], f"{j['angle_rad']:g}", _eig_text(j["eigenvalues"]),
+                             f"{j['spectral_radius']:.3f}", f"{100 * j['relative_residual']:.0f} %", reg_text])
+    return rows
+
+
+def _intro(record: dict) -> str:
     s = record["settings"]
+    return (f"Torque-free period {s['window'][0]:g}–{s['window'][1]:g} s; pushes ±{s['push_force_n']:g} N on the "
+            f"torso for {s['push_duration_s']:g} s from {s['push_start_s']:g} s; {s['trials']} trials per cell "
+            f"(initial hip angle and speed within ±{100 * s['spread']:g} %, seed {s['seed']}); x* = mean "
+            f"undisturbed section state from touchdown {s['steady_from_step']} on; section state = (inter-leg "
+            "hip angle, rate) at touchdown.")
+
+
+def report_markdown(record: dict) -> str:
     lines = [
         "# Stability report: Table VI (return-map eigenvalues) beside the paper's",
         "",
-        f"Torque-free period {s['window'][0]:g}–{s['window'][1]:g} s; pushes ±{s['push_force_n']:g} N on the "
-        f"torso for {s['push_duration_s']:g} s from {s['push_start_s']:g} s; {s['trials']} trials per cell "
-        f"(initial hip angle and speed within ±{100 * s['spread']:g} %, seed {s['seed']}); x* = mean undisturbed "
-        f"section state from touchdown {s['steady_from_step']} on; section state = (inter-leg hip angle, rate) "
-        "at touchdown.",
+        _intro(record),
         "",
         "| " + " | ".join(h for _, h in COLUMNS) + " |",
         "|" + "---|" * len(COLUMNS),
@@ -125,24 +152,11 @@ def report_markdown(record: dict) -> str:
         lines.append("| " + " | ".join(row[k] for k, _ in COLUMNS) + " |")
     lines += ["", "A cell is stable when the spectral radius ρ of its fitted return map is below 1 and no trial "
               "fell; every cell of the paper's Table VI is. ![Fig. 7](fig7_return_map.png)", ""]
-    jac = record.get("jacobian")
-    if jac:
-        lines += ["## Step-to-step Jacobian by finite differences in Drake, beside the regression", "",
-                  "Kicks of the swing hip 30 ms before touchdown 8 (angle ε, rate 10ε, 16 directions); J by least "
-                  "squares from the measured Δx_n, Δx_n+1. The residual is the part of Δx_n+1 that J does not "
-                  "explain: the controller runs on a 1 ms grid, so the step map has small jumps, and where they "
-                  "are as large as the linear response J is not identifiable at that kick size.", "",
-                  "| condition | kick ε (rad) | λ | ρ | residual | regression ρ (undisturbed) |",
-                  "|---|---|---|---|---|---|"]
-        for condition in CONDITIONS:
-            reg = record["cells"][condition]["undisturbed"].get("spectral_radius")
-            for j in jac.get(condition, []):
-                if "error" in j:
-                    lines.append(f"| {CONDITION_NAMES[condition]} | {j['angle_rad']:g} | {j['error']} | | | |")
-                    continue
-                lines.append(f"| {CONDITION_NAMES[condition]} | {j['angle_rad']:g} | {_eig_text(j['eigenvalues'])} | "
-                             f"{j['spectral_radius']:.3f} | {100 * j['relative_residual']:.0f} % | "
-                             f"{'—' if reg is None else f'{reg:.3f}'} |")
+    jac_rows = _jacobian_rows(record)
+    if jac_rows:
+        lines += [f"## {JACOBIAN_TITLE}", "", JACOBIAN_TEXT, "", "| " + " | ".join(JACOBIAN_COLUMNS) + " |",
+                  "|" + "---|" * len(JACOBIAN_COLUMNS)]
+        lines += ["| " + " | ".join(row) + " |" for row in jac_rows]
         lines.append("")
     v = record.get("versions", {})
     lines.append(f"drake-biped {v.get('drake_biped', '?')} ({v.get('git_commit', '?')}), Drake {v.get('drake', '?')}.")
@@ -153,8 +167,7 @@ def report_html(record: dict) -> str:
     rows = _rows(record)
     head = "".join(f"<th>{html.escape(h)}</th>" for _, h in COLUMNS)
     body = "".join("<tr>" + "".join(f"<td>{html.escape(r[k])}</td>" for k, _ in COLUMNS) + "</tr>" for r in rows)
-    md = report_markdown(record).split("\n")
-    intro = html.escape(md[2])
+    intro = html.escape(_intro(record))
     return (
         "<!doctype html><html><head><meta charset='utf-8'><title>drake-biped stability report</title>"
         "<style>body{font-family:sans-serif;max-width:70em;margin:2em auto}table{border-collapse:collapse}"
@@ -169,16 +182,13 @@ def report_html(record: dict) -> str:
 
 
 def _jacobian_html(record: dict) -> str:
-    md = report_markdown(record)
-    if "## Step-to-step Jacobian" not in md:
+    rows = _jacobian_rows(record)
+    if not rows:
         return ""
-    part = md.split("## Step-to-step Jacobian", 1)[1].split("\ndrake-biped ", 1)[0]
-    rows = [line for line in part.splitlines() if line.startswith("|") and not line.startswith("|---")]
-    text = [line for line in part.splitlines()[1:] if line and not line.startswith("|")]
-    cells = lambda line, tag: "".join(f"<{tag}>{html.escape(c.strip())}</{tag}>" for c in line.strip("|").split("|"))  # noqa: E731
-    table = "<tr>" + cells(rows[0], "th") + "</tr>" + "".join("<tr>" + cells(r, "td") + "</tr>" for r in rows[1:])
-    return ("<h2>Step-to-step Jacobian by finite differences in Drake, beside the regression</h2>"
-            f"<p>{html.escape(' '.join(text))}</p><table>{table}</table>")
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in JACOBIAN_COLUMNS)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>" for row in rows)
+    return (f"<h2>{html.escape(JACOBIAN_TITLE)}</h2><p>{html.escape(JACOBIAN_TEXT)}</p>"
+            f"<table><tr>{head}</tr>{body}</table>")
 
 
 def write_stability_outputs(record: dict, out: str | Path) -> list[Path]:

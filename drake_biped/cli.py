@@ -278,8 +278,8 @@ def cmd_landscape(args: argparse.Namespace) -> int:
     except (json.JSONDecodeError, KeyError, TypeError) as exc:
         raise ParameterError(f"landscape: {path} is not a window map ({exc})") from None
     starts = [tuple(args.start)] if args.start else [(0.5, 0.5)]
-    record = landscape(rewards, args.variance, samples=args.samples, seed=args.seed or 0, starts=starts)
-    record.update(window_map=str(path), samples=args.samples, seed=args.seed or 0, versions=versions())
+    record = landscape(rewards, args.variance, samples=args.samples, seed=args.seed, starts=starts)
+    record.update(window_map=str(path), samples=args.samples, seed=args.seed, versions=versions())
     out = Path(args.out) if args.out else path.parent
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "landscape.json", record)

@@ -250,7 +250,7 @@ class SessionLog:
             try:
                 self.sessions = list(json.loads(path.read_text()).get("sessions", []))
             except (json.JSONDecodeError, AttributeError):
-                self.sessions = []
+                pass  # an unreadable log starts afresh; learning.json and the trials are not affected
         self.t0 = time.perf_counter()
         self.every_s = every_s
         self._last = -math.inf
@@ -268,7 +268,7 @@ class SessionLog:
         self.current["finished"] = finished
         if force or finished or now - self._last >= self.every_s:
             self._last = now
-            done = [s for s in self.sessions] + [self.current]
+            done = [*self.sessions, self.current]
             episodes_all = sum(s["episodes"] for s in done)
             wall_all = sum(s["learning_wall_s"] for s in done)
             write_atomic(self.path, {

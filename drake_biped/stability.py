@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from analysis.return_map import complex_list, fit_return_map, least_squares_map
 from drake_biped.params import EpisodeConfig, InitialConditions, ParameterError, Push, TorqueFreeWindow
 from drake_biped.versions import versions
 
@@ -78,6 +79,11 @@ class StabilitySettings:
         return d
 
 
+def condition_window(condition: str, window: tuple[float, float]) -> TorqueFreeWindow:
+    """The torque-free window of a condition: `window` "with", none "without"."""
+    return TorqueFreeWindow(*window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+
+
 def trial_initial(base: InitialConditions, seed: int, trial: int, spread: float) -> InitialConditions:
     """Trial 0: `base`; trial k: its hip angle and speed scaled by seeded factors in [1 - spread, 1 + spread]."""
     if trial == 0 or spread == 0:
@@ -92,7 +98,7 @@ def cell_configs(base: EpisodeConfig, settings: StabilitySettings) -> list[tuple
     out = []
     signs = {"undisturbed": 0.0, "forward": 1.0, "backward": -1.0}
     for condition in CONDITIONS:
-        window = TorqueFreeWindow(*settings.window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+        window = condition_window(condition, settings.window)
         for kind in DISTURBANCES:
             push = None
             if signs[kind]:
@@ -119,17 +125,15 @@ def section_sequence(result: dict[str, Any], push_start_s: float | None) -> tupl
 
 def equilibrium(results: list[dict[str, Any]], steady_from_step: int) -> np.ndarray:
     """Mean section state of undisturbed trials over their touchdowns from `steady_from_step` on."""
-    rows = [np.array([[s["hip_angle_rad"], s["hip_rate_radps"]]
-                      for s in r["steps"] if s["index"] >= steady_from_step]).reshape(-1, 2) for r in results]
-    rows = [r for r in rows if len(r)]
-    if not rows:
+    steady = np.vstack([section_sequence(r, None)[0][[s["index"] >= steady_from_step for s in r["steps"]]]
+                        for r in results])
+    if not len(steady):
         raise ValueError(f"no undisturbed touchdowns from step {steady_from_step} on: walk further")
-    return np.vstack(rows).mean(axis=0)
+    return steady.mean(axis=0)
 
 
 def analyse(results: dict[tuple[str, str, int], dict[str, Any]], settings: StabilitySettings) -> dict[str, Any]:
     """Fit the six cells' return maps; the record that stability.json holds (besides settings and versions)."""
-    from analysis.return_map import complex_list, fit_return_map
 
     cells: dict[str, dict[str, Any]] = {}
     for condition in CONDITIONS:
@@ -214,7 +218,7 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
             progress(done, total)
     jacobian: dict[str, list[dict[str, Any]]] = {}
     for condition in CONDITIONS:
-        window = TorqueFreeWindow(*settings.window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+        window = condition_window(condition, settings.window)
         config = base.replace(window=window, seed=settings.seed)
         jacobian[condition] = []
         for size in jacobian_kicks:
@@ -261,7 +265,7 @@ def push_margin(base: EpisodeConfig, window: tuple[float, float], client, max_fo
     distance = base.sim.distance_m
     chains = {}
     for condition in CONDITIONS:
-        w = TorqueFreeWindow(*window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
+        w = condition_window(condition, window)
         for direction, sign in (("forward", 1.0), ("backward", -1.0)):
             chains[(condition, direction)] = {"window": w, "sign": sign, "lo": 0.0, "hi": None, "tried": []}
 
@@ -298,13 +302,6 @@ def push_margin(base: EpisodeConfig, window: tuple[float, float], client, max_fo
             "survived_n": c["lo"], "fell_n": c["hi"], "impulse_ns": c["lo"] * push_duration_s,
             "tried": c["tried"]}
     return out
-
-
-def kicked_task(config: dict[str, Any], kick: dict[str, float] | None) -> dict[str, Any]:
-    """Dask task: one episode with an optional swing-hip kick (drake_biped.episode.Kick)."""
-    from drake_biped.episode import Kick, run_episode
-
-    return run_episode(EpisodeConfig.from_dict(config), kick=Kick(**kick) if kick else None).to_dict()
 
 
 def _section(result: dict[str, Any], index: int) -> np.ndarray | None:
@@ -352,7 +349,7 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle
     angles = phase + 2 * np.pi * np.arange(kicks) / kicks
     plan = [{"time_s": t_kick, "hip_angle_rad": float(np.cos(a) * angle_rad),
              "hip_rate_radps": float(np.sin(a) * rate_radps)} for a in angles]
-    runs = client.gather([client.submit(kicked_task, cfg, k, pure=False) for k in plan])
+    runs = client.gather([client.submit(episode_task, cfg, k, pure=False) for k in plan])
     dx, dy, lost = [], [], 0
     for r in runs:
         x, y = _section(r, step), _section(r, step + 1)
@@ -364,11 +361,9 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle
     if len(dx) < 3:
         raise RuntimeError(f"{lost} of {kicks} kicks ended the walk before touchdown {step + 1}: use smaller kicks")
     dx, dy = np.array(dx), np.array(dy)
-    jac_t, *_ = np.linalg.lstsq(dx, dy, rcond=None)
-    jac = jac_t.T
-    res = dy - dx @ jac_t
+    jac = least_squares_map(dx, dy)
+    res = dy - dx @ jac.T
     eig = np.linalg.eigvals(jac)
-    from analysis.return_map import complex_list
 
     return {
         "jacobian": jac.tolist(),
