@@ -292,3 +292,100 @@ def table_v(record: dict) -> str:
         lines.append(f"| {r['trial']} | {r['t1']:.3f} | {r['t2']:.3f} | {fmt(r['cost_of_transport'])} | "
                      f"{'yes' if not r['fell'] else 'no'} |")
     return "\n".join(lines) + "\n"
+
+
+def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, path: str | Path,
+                       distance_m: float) -> None:
+    """Walking distance over every pair of grid axes that vary, the other axes held at the best point's
+    values (true slices through the best point, not projections). One axis that varies: a line."""
+    varying = [a for a in axes if len(a.values) > 1]
+    lookup = {tuple(p[a.name] for a in axes): r["distance_m"] for p, r in zip(points, rows)}
+
+    def distance(assign: dict) -> float:
+        return lookup.get(tuple(assign.get(a.name, best[a.name]) for a in axes), np.nan)
+
+    pairs = [(a, b) for i, a in enumerate(varying) for b in varying[i + 1 :]]
+    short = {a.name: a.name.split(".")[-1] for a in axes}
+    if not pairs:
+        fig, ax = plt.subplots(figsize=(5.5, 3.6))
+        if varying:
+            a = varying[0]
+            ax.plot(a.values, [distance({a.name: v}) for v in a.values], "o-")
+            ax.set_xlabel(short[a.name])
+        ax.set_ylabel("walking distance (m)")
+        ax.set_ylim(0, distance_m * 1.05)
+    else:
+        cols = min(4, len(pairs))
+        nrows = -(-len(pairs) // cols)
+        fig, grid = plt.subplots(nrows, cols, figsize=(3.3 * cols, 2.9 * nrows), squeeze=False)
+        image = None
+        for ax, (a, b) in zip(grid.flat, pairs):
+            z = np.array([[distance({a.name: va, b.name: vb}) for va in a.values] for vb in b.values])
+            image = ax.imshow(z, origin="lower", aspect="auto", vmin=0, vmax=distance_m, cmap="viridis")
+            ax.set_xticks(range(len(a.values)), [f"{v:.3g}" for v in a.values], fontsize=7)
+            ax.set_yticks(range(len(b.values)), [f"{v:.3g}" for v in b.values], fontsize=7)
+            ax.set_xlabel(short[a.name], fontsize=8)
+            ax.set_ylabel(short[b.name], fontsize=8)
+            ax.plot(a.values.index(best[a.name]), b.values.index(best[b.name]), "r*", ms=9)
+        for ax in list(grid.flat)[len(pairs):]:
+            ax.axis("off")
+        fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.8, label="walking distance (m)")
+    fixed = ", ".join(f"{short[a.name]}={best[a.name]:.3g}" for a in axes)
+    fig.suptitle(f"Grid search: distance walked, slices through the best point (red star: {fixed})", fontsize=9)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def slope_figures(record: dict, out: str | Path) -> list[Path]:
+    """The torque-free period (the paper's Fig. 8 at 0.02 rad, Fig. 10 at 2.0 deg) and the walking distance
+    (Fig. 9 / Fig. 11) over the episodes of online learning on the slope, 20-episode moving averages, one
+    line per trial; with the starting policy's period and the two check episodes for reference."""
+    from drake_biped.slope import MOVING_AVERAGE, moving_average, period
+
+    out = Path(out)
+    slope = record["ground"]["slope_rad"]
+    level = record["ground"]["level_length_m"]
+    target = record["settings"]["config"]["sim"]["distance_m"]
+    where = f"{level:g} m level, then {slope:g} rad ({np.degrees(slope):.2f}°)"
+    paths = [out / "fig8_period.png", out / "fig9_distance.png"]
+
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for k, trial in enumerate(record["episodes"]):
+        ep = trial["episodes"]
+        x = np.arange(1, len(ep) + 1)
+        color = f"C{k % 10}"
+        ax.plot(x, moving_average([period(e["t1"], e["t2"]) for e in ep]), color=color,
+                label=f"trial {trial['trial']}: sampled period, {MOVING_AVERAGE}-episode average")
+        ax.plot(x, [period(e["mean_t1"], e["mean_t2"]) for e in ep], color=color, ls=":", lw=1,
+                label=f"trial {trial['trial']}: policy mean's period")
+    ax.axhline(record["start"]["period_s"], color="k", ls="--", lw=0.8, label="learned on level ground (start)")
+    ax.set_xlabel("episode on the slope")
+    ax.set_ylabel("torque-free period t2 - t1 (s)")
+    ax.set_ylim(bottom=0)
+    ax.set_title(f"Torque-free period during learning ({where})", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(paths[0], dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for k, trial in enumerate(record["episodes"]):
+        ep = trial["episodes"]
+        x = np.arange(1, len(ep) + 1)
+        ax.plot(x, [e["distance_m"] for e in ep], ".", color=f"C{k % 10}", ms=3, alpha=0.4)
+        ax.plot(x, moving_average([e["distance_m"] for e in ep]), color=f"C{k % 10}",
+                label=f"trial {trial['trial']}, {MOVING_AVERAGE}-episode average")
+    checks = record["checks"]
+    ax.axhline(checks["start_window"]["distance_m"], color="C3", ls="--", lw=0.8,
+               label="learned period, no learning")
+    ax.axhline(checks["no_window"]["distance_m"], color="k", ls="--", lw=0.8, label="no torque-free period")
+    ax.axhline(level, color="0.5", ls=":", lw=0.8, label="slope starts")
+    ax.set_xlabel("episode on the slope")
+    ax.set_ylabel("walking distance (m)")
+    ax.set_ylim(0, target * 1.05)
+    ax.set_title(f"Walking distance during learning ({where})", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(paths[1], dpi=120)
+    plt.close(fig)
+    return paths

@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin | grid | slope`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -296,23 +296,17 @@ def cmd_landscape(args: argparse.Namespace) -> int:
 
 
 def _policy_window(path: Path) -> tuple[float, float]:
-    """The learned torque-free period of a learning run: of its trials whose final policy mean has a
-    window (t̄2 > t̄1) and walked the distance in the evaluation, the one with the lowest C_mt. (A mean over
-    trials would blend trials that learned a window with trials that learned none.)"""
+    """The learned torque-free period of a learning.json (`learning.best_learned_trial`)."""
+    from drake_biped.learning import best_learned_trial
+
     if not path.is_file():
         raise ParameterError(f"--policy: no such file: {path}")
     try:
-        learned = json.loads(path.read_text())["evaluation"]["learned"]
-        rows = [(float(r["cost_of_transport"]), max(0.0, float(r["t1"])), max(0.0, float(r["t2"])))
-                for r in learned if not r["fell"] and r["cost_of_transport"] is not None]
-    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
-        raise ParameterError(f"--policy {path}: not a learning.json with an evaluation ({exc})") from None
-    rows = [r for r in rows if r[2] > r[1]]
-    if not rows:
-        raise ParameterError(f"--policy {path}: no trial learned a torque-free period that walks "
-                             "(every final mean has t2 <= t1); give --t1 and --t2")
-    _, t1, t2 = min(rows)
-    return t1, t2
+        record = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"--policy {path}: not valid JSON ({exc})") from None
+    row = best_learned_trial(record, f"--policy {path}")
+    return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
 
 
 def _chosen_window(args: argparse.Namespace) -> tuple[float, float]:
@@ -398,6 +392,84 @@ def cmd_push_margin(args: argparse.Namespace) -> int:
     (out / "push_margin.md").write_text(text)
     print(text)
     print(f"wrote {out}/push_margin.json, push_margin.md")
+    return 0
+
+
+def cmd_grid(args: argparse.Namespace) -> int:
+    from drake_biped.grid import load_spec, run_grid, table_iv_axes
+    from drake_biped.parallel import dask_client
+
+    config = _episode_config(args)
+    _check_cluster_options(args)
+    if args.spec is not None and args.points_per_axis is not None:
+        raise ParameterError("give either --spec or --points-per-axis, not both")
+    axes = load_spec(Path(args.spec)) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
+    out = Path(args.out)
+    from tqdm import tqdm
+
+    bar = tqdm(total=0, desc="grid", unit="point")
+
+    def progress(done: int, total: int) -> None:
+        bar.total = total
+        bar.n = done
+        bar.refresh()
+
+    try:
+        with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+            record = run_grid(out, config, axes, client, progress)
+    finally:
+        bar.close()
+    best = record["best"]
+    cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
+    print(f"{record['walked_the_distance']}/{record['points']} points walk {config.sim.distance_m:g} m; best "
+          f"{', '.join(f'{k}={v:.4g}' for k, v in best['point'].items())}: {best['distance_m']:.2f} m, C_mt {cmt}")
+    print(f"wrote {out}/grid.csv, grid.json, grid_slices.png, best_params.json (use --params)")
+    return 0
+
+
+def cmd_slope(args: argparse.Namespace) -> int:
+    from drake_biped.learning import SessionLog
+    from drake_biped.parallel import dask_client
+    from drake_biped.slope import run_slope, slope_ground, start_from_learning, start_from_window
+
+    if args.slope is None:
+        raise ParameterError("--slope is required (rad, > 0: the ascending slope after the level part)")
+    level = args.level_length if args.level_length is not None else 2.0
+    args.level_length = None  # the slope ground is built below, not by the episode options
+    slope, args.slope = args.slope, None
+    config = _episode_config(args)
+    ground = slope_ground(slope, level, config.ground.friction)
+    _check_cluster_options(args)
+    if args.policy is not None:
+        if args.t1 is not None or args.t2 is not None:
+            raise ParameterError("give either --policy or --t1/--t2, not both")
+        state, source = start_from_learning(Path(args.policy))
+    else:
+        state, source = start_from_window(*_chosen_window(args), args.variance)
+    out = Path(args.out)
+    from tqdm import tqdm
+
+    bar = tqdm(total=args.trials * args.episodes, desc="slope learning", unit="episode")
+    out.mkdir(parents=True, exist_ok=True)
+    log = SessionLog(out / "run.json", args.workers, args.scheduler)
+    first: list[int] = []
+
+    def progress(done: int, total: int, latest: float | None) -> None:
+        if not first:
+            first.append(done)
+        log.update(done - first[0])
+        bar.n = done
+        bar.refresh()
+
+    try:
+        with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+            run_slope(out, config, ground, state, source, args.trials, args.episodes, config.seed,
+                      client, progress)
+    finally:
+        bar.close()
+    log.update(0 if not first else bar.n - first[0], finished=True)
+    print((out / "report.md").read_text())
+    print(f"wrote {out}/slope.json, report.md, fig8_period.png, fig9_distance.png")
     return 0
 
 
@@ -506,6 +578,29 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_options(pm)
     pm.add_argument("--out", required=True, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
+
+    grid = sub.add_parser("grid", help="grid search of CPG parameters and the initiation (Table IV), on Dask")
+    _add_episode_options(grid)
+    grid.add_argument("--points-per-axis", type=_count, default=None,
+                      help="points per Table IV range (cell centres); default 2 (32 points)")
+    grid.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
+                      "{values: [...]}}; see grids/")
+    _add_cluster_options(grid)
+    grid.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    grid.set_defaults(func=cmd_grid)
+
+    sl = sub.add_parser("slope", help="slope adaptation: does the learned torque-free period climb, does none, "
+                        "and does online GARB learning adapt it (Figs. 8-11), on Dask")
+    _add_episode_options(sl)
+    _add_window_options(sl)
+    sl.add_argument("--variance", type=_number("positive"), default=0.01,
+                    help="the policy's variance (s^2) when starting from --t1/--t2; default 0.01 "
+                    "(--policy carries its own)")
+    sl.add_argument("--episodes", type=_count, default=100, help="learning episodes per trial (default 100)")
+    sl.add_argument("--trials", type=_count, default=2, help="independent learning trials (default 2)")
+    _add_cluster_options(sl)
+    sl.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    sl.set_defaults(func=cmd_slope)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")

@@ -115,6 +115,15 @@ class GarbLearner:
             "rng": self._rng.bit_generator.state,
         }
 
+    def restarted(self, seed: int | None = None) -> GarbLearner:
+        """A new run that starts from this learner's policy: the same mean, variance, beta, schedule and
+        eligibility trace; the episode count back at 0, so alpha_p follows the schedule from its first band
+        and the baseline becomes the running mean of the new run's rewards (eq. 7 from i = 1); its own RNG."""
+        learner = GarbLearner(self.mean, self.variance, self.beta, self.schedule, seed=seed)
+        learner.trace = self.trace.copy()
+        learner.baseline = self.baseline
+        return learner
+
     @classmethod
     def from_state(cls, state: dict[str, Any]) -> GarbLearner:
         learner = cls(state["mean"], state["variance"], state["beta"], [tuple(b) for b in state["schedule"]])

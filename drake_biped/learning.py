@@ -85,6 +85,7 @@ class Trial:
         self.path = out / "trials" / f"trial_{index}.json"
         self.settings = settings
         self.config = EpisodeConfig.from_dict(settings["config"])
+        start = settings["learner"].get("start_state")
         if self.path.is_file():
             record = json.loads(self.path.read_text())
             if _fixed(record.get("settings", {})) != _fixed(settings):
@@ -94,6 +95,9 @@ class Trial:
                 )
             self.episodes: list[dict[str, Any]] = record["episodes"]
             self.learner = GarbLearner.from_state(record["learner"])
+        elif start is not None:  # a new run from a learned policy (the slope experiment)
+            self.episodes = []
+            self.learner = GarbLearner.from_state(start).restarted(seed=trial_seed(settings["seed"], index))
         else:
             self.episodes = []
             ls = settings["learner"]
@@ -155,6 +159,22 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
         "learner": {"mean": list(map(float, mean)), "variance": float(variance), "beta": float(beta),
                     "schedule": [list(b) for b in schedule]},
     }
+
+
+def best_learned_trial(record: dict[str, Any], source: str = "learning.json") -> dict[str, Any]:
+    """The learned torque-free period of a learning record: of the trials whose final policy mean has a
+    window (t̄2 > t̄1) and walked the distance in the evaluation, the one with the lowest C_mt (a mean over
+    trials would blend trials that learned a window with trials that learned none). Its evaluation row
+    (trial, t1, t2, cost_of_transport, ...); ParameterError if there is none."""
+    try:
+        rows = [r for r in record["evaluation"]["learned"]
+                if not r["fell"] and r["cost_of_transport"] is not None and float(r["t2"]) > max(0.0, float(r["t1"]))]
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ParameterError(f"{source}: not a learning record with an evaluation ({exc})") from None
+    if not rows:
+        raise ParameterError(f"{source}: no trial learned a torque-free period that walks "
+                             "(every final mean has t2 <= t1)")
+    return min(rows, key=lambda r: float(r["cost_of_transport"]))
 
 
 def run_learning(

@@ -265,6 +265,11 @@ class Ground(_Validated):
             return self.slope_rad
         return 0.0
 
+    def normal(self, x: float) -> tuple[float, float]:
+        """Upward unit normal (n_x, n_z) of the surface at x (in the sagittal x-z plane)."""
+        s = self.slope_at(x)
+        return (-math.sin(s), math.cos(s))
+
 
 @dataclass(frozen=True)
 class SimulationParams(_Validated):

@@ -83,10 +83,13 @@ def test_malformed_model_is_a_clear_error(tmp_path):
     (Ground(slope_rad=0.05), 3.0, 3.0 * math.tan(0.05)),
     (Ground(slope_rad=0.02, level_length_m=2.0), 1.5, 0.0),
     (Ground(slope_rad=0.02, level_length_m=2.0), 4.0, 2.0 * math.tan(0.02)),
+    (Ground(slope_rad=0.0349, level_length_m=2.0), 7.0, 5.0 * math.tan(0.0349)),
+    (Ground(slope_rad=-0.05), 3.0, -3.0 * math.tan(0.05)),
 ])
 def test_ground_geometry_matches_its_height_function(ground, x, expected_height):
     """SceneGraph's signed distance from a point above the ground equals the height above the surface
-    (measured along the normal), for level, tilted and level-then-slope ground."""
+    (measured along the normal), and its gradient is the ground's normal, for level, tilted and
+    level-then-slope ground."""
     from pydrake.systems.framework import DiagramBuilder
 
     builder = DiagramBuilder()
@@ -96,8 +99,15 @@ def test_ground_geometry_matches_its_height_function(ground, x, expected_height)
     query = handles.scene_graph.get_query_output_port().Eval(handles.scene_graph.GetMyContextFromRoot(ctx))
     z = 1.0
     inspector = query.inspector()
-    distances = [d.distance for d in query.ComputeSignedDistanceToPoint(np.array([x, 0.0, z]))
-                 if inspector.GetName(d.id_G).endswith(("ground", "ground_level", "ground_slope"))]
+    near = min((d for d in query.ComputeSignedDistanceToPoint(np.array([x, 0.0, z]))
+                if inspector.GetName(d.id_G).endswith(("ground", "ground_level", "ground_slope"))),
+               key=lambda d: d.distance)
     slope = ground.slope_at(x)
     assert ground.height(x) == pytest.approx(expected_height)
-    assert min(distances) == pytest.approx((z - expected_height) * math.cos(slope), abs=1e-9)
+    assert near.distance == pytest.approx((z - expected_height) * math.cos(slope), abs=1e-9)
+    nx, nz = ground.normal(x)
+    np.testing.assert_allclose(near.grad_W, [nx, 0.0, nz], atol=1e-12)
+    # The normal is perpendicular to the surface: along the height function's local tangent.
+    h = 1e-6
+    tangent = np.array([2 * h, ground.height(x + h) - ground.height(x - h)])
+    assert abs(np.dot(tangent / np.linalg.norm(tangent), [nx, nz])) < 1e-6

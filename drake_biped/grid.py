@@ -1,0 +1,267 @@
+"""Grid search over CPG parameters and the initiation (SPEC §6.5, Table IV), on Dask.
+
+Every grid point is one episode (walk until a fall or the distance) of the base configuration with the
+point's values put in. The axes are dotted EpisodeConfig fields (`cpg.u_a`, `initial.speed_mps`,
+`gait.torso_pitch_rad`, ...) or the short names of Table IV (alpha, u_a, u_eta, u_r, kappa) and of the
+initiation (hip_angle, speed). A range of K points is split into K equal cells with a point at the centre
+of each (K = 1: the middle), so no point sits on an edge where the CPG stops (u_r = 0).
+
+The best point walks furthest (to the centimetre); among points that go equally far, the lowest C_mt wins.
+It is written as a parameter file that every command accepts (`--params DIR/best_params.json`).
+
+Nothing lost: each finished point is appended to OUT/points.jsonl (and flushed) as it arrives; a rerun with
+the same base configuration reads them back and runs only the points missing. A truncated last line (a run
+killed while writing) is ignored and its point rerun.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import itertools
+import json
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.versions import versions
+
+# Table IV of the paper: the grid search's ranges of the CPG parameters.
+TABLE_IV: dict[str, tuple[float, float]] = {
+    "alpha": (-2.0, 2.0),
+    "u_a": (0.0, 3.0),
+    "u_eta": (-1.0, 1.0),
+    "u_r": (0.0, 3.0),
+    "kappa": (0.0, 2.0),
+}
+SHORT_NAMES = {
+    "alpha": "cpg.alpha",
+    "u_a": "cpg.u_a",
+    "u_eta": "cpg.u_eta",
+    "u_r": "cpg.u_r",
+    "kappa": "cpg.kappa",
+    "hip_angle": "initial.hip_angle_rad",
+    "speed": "initial.speed_mps",
+}
+_SECTIONS = ("cpg", "gait", "initial", "window", "ground", "sim")
+RESULT_FIELDS = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps",
+                 "step_period_s", "steps")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One grid axis: a dotted EpisodeConfig field and the values it takes."""
+
+    name: str
+    values: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if not self.values:
+            raise ParameterError(f"grid axis {self.name}: no values")
+        for v in self.values:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise ParameterError(f"grid axis {self.name}: value {v!r} is not a finite number")
+
+
+def field_name(name: str) -> str:
+    """The dotted EpisodeConfig field of an axis name (short or dotted); ParameterError if unknown."""
+    dotted = SHORT_NAMES.get(name, name)
+    section, _, attr = dotted.partition(".")
+    base = EpisodeConfig()
+    if section not in _SECTIONS or not attr or "." in attr or not hasattr(getattr(base, section), attr) \
+            or not isinstance(getattr(getattr(base, section), attr), float):
+        raise ParameterError(f"grid axis {name!r}: not a numeric EpisodeConfig field; use one of "
+                             f"{sorted(SHORT_NAMES)} or section.field with section in {list(_SECTIONS)}")
+    return dotted
+
+
+def cell_centres(lo: float, hi: float, points: int) -> tuple[float, ...]:
+    """`points` values at the centres of `points` equal cells of [lo, hi], rounded to 1e-9."""
+    if isinstance(points, bool) or not isinstance(points, int) or points < 1:
+        raise ParameterError(f"points per axis {points!r}: must be an integer >= 1")
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+        raise ParameterError(f"range [{lo!r}, {hi!r}]: need finite lo <= hi")
+    width = (hi - lo) / points
+    return tuple(round(lo + (k + 0.5) * width, 9) for k in range(points))
+
+
+def table_iv_axes(points_per_axis: int) -> list[Axis]:
+    """Table IV's five CPG ranges, `points_per_axis` cell centres each."""
+    return [Axis(field_name(n), cell_centres(lo, hi, points_per_axis)) for n, (lo, hi) in TABLE_IV.items()]
+
+
+def parse_spec(spec: Any, source: str = "grid spec") -> list[Axis]:
+    """Axes from a spec mapping: {"axes": {name: {"min": lo, "max": hi, "points": K} | {"values": [...]}}}.
+
+    The order of the axes is the file's; a point's values are applied in that order."""
+    if not isinstance(spec, dict) or not isinstance(spec.get("axes"), dict) or not spec["axes"]:
+        raise ParameterError(f"{source}: expected a mapping with a non-empty 'axes' mapping")
+    unknown = sorted(set(spec) - {"axes"})
+    if unknown:
+        raise ParameterError(f"{source}: unknown key(s) {unknown}; a grid spec has 'axes' only")
+    axes = []
+    for name, entry in spec["axes"].items():
+        dotted = field_name(str(name))
+        if isinstance(entry, dict) and set(entry) == {"values"} and isinstance(entry["values"], list):
+            values = tuple(entry["values"])
+        elif isinstance(entry, dict) and set(entry) == {"min", "max", "points"}:
+            try:
+                values = cell_centres(float(entry["min"]), float(entry["max"]), entry["points"])
+            except ParameterError as exc:
+                raise ParameterError(f"{source}: axis {name}: {exc}") from None
+            except (TypeError, ValueError):
+                raise ParameterError(f"{source}: axis {name}: min and max must be numbers, got {entry}") from None
+        else:
+            raise ParameterError(f"{source}: axis {name}: expected {{min, max, points}} or {{values: [...]}}, "
+                                 f"got {entry!r}")
+        axes.append(Axis(dotted, values))
+    if len({a.name for a in axes}) != len(axes):
+        raise ParameterError(f"{source}: an axis is given twice (short and dotted names of one field)")
+    return axes
+
+
+def load_spec(path: Path) -> list[Axis]:
+    """Axes from a YAML (or JSON) spec file; see `parse_spec`."""
+    import yaml
+
+    if not path.is_file():
+        raise ParameterError(f"--spec: no such file: {path}")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ParameterError(f"--spec {path}: not valid YAML ({exc})") from None
+    return parse_spec(data, f"--spec {path}")
+
+
+def grid_points(axes: list[Axis]) -> list[dict[str, float]]:
+    """Every combination of the axes' values (the last axis varies fastest)."""
+    names = [a.name for a in axes]
+    return [dict(zip(names, combo)) for combo in itertools.product(*(a.values for a in axes))]
+
+
+def point_config(base: EpisodeConfig, point: dict[str, float]) -> EpisodeConfig:
+    """`base` with the point's values put in; ParameterError naming the point if a value is out of range."""
+    data = base.to_dict()
+    for name, value in point.items():
+        section, attr = name.split(".")
+        data[section][attr] = float(value)
+    try:
+        return EpisodeConfig.from_dict(data)
+    except ParameterError as exc:
+        raise ParameterError(f"grid point {point}: {exc}") from None
+
+
+def _key(config: dict[str, Any]) -> str:
+    return hashlib.sha1(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def better(a: dict[str, Any], b: dict[str, Any] | None) -> bool:
+    """Whether row a beats row b: further (to the centimetre), then lower C_mt."""
+    if b is None:
+        return True
+    da, db = round(a["distance_m"], 2), round(b["distance_m"], 2)
+    if da != db:
+        return da > db
+    ca = a["cost_of_transport"] if a["cost_of_transport"] is not None else math.inf
+    cb = b["cost_of_transport"] if b["cost_of_transport"] is not None else math.inf
+    return ca < cb
+
+
+def read_points(path: Path) -> dict[str, dict[str, Any]]:
+    """Finished rows of OUT/points.jsonl by key; unreadable lines (a killed write) are skipped."""
+    rows: dict[str, dict[str, Any]] = {}
+    if path.is_file():
+        for line in path.read_text().splitlines():
+            try:
+                row = json.loads(line)
+                rows[row["key"]] = row
+            except (json.JSONDecodeError, KeyError, TypeError):
+                continue
+    return rows
+
+
+def run_grid(out: Path, base: EpisodeConfig, axes: list[Axis], client,
+             progress: Callable[[int, int], None] | None = None, in_flight: int | None = None) -> dict[str, Any]:
+    """Run (or finish) every point of the grid on Dask; write points.jsonl, grid.csv, grid.json,
+    best_params.json and the slice figure; return the grid record."""
+    from distributed import as_completed
+
+    from drake_biped.parallel import episode_task
+
+    code = versions()
+    out.mkdir(parents=True, exist_ok=True)
+    points = grid_points(axes)
+    configs = [point_config(base, p).to_dict() for p in points]  # every point validated before any runs
+    keys = [_key(c) for c in configs]
+    store = out / "points.jsonl"
+    done = read_points(store)
+    first = {k: i for i, k in reversed(list(enumerate(keys)))}  # a point given twice runs once
+    todo = sorted(i for k, i in first.items() if k not in done)
+    total = len(first)
+    finished = total - len(todo)
+    if progress:
+        progress(finished, total)
+    if todo:
+        limit = in_flight or 4 * max(1, len(client.scheduler_info().get("workers", {})) or 1)
+        pending = iter(todo)
+        futures = {}
+        for i in itertools.islice(pending, limit):
+            futures[client.submit(episode_task, configs[i], pure=False)] = i
+        queue = as_completed(list(futures))
+        with open(store, "a") as f:
+            if f.tell() > 0 and not store.read_bytes().endswith(b"\n"):
+                f.write("\n")  # a killed write left half a line: start the next on its own
+            for future in queue:
+                i = futures.pop(future)
+                r = future.result()
+                row = {"key": keys[i], "point": points[i], **{k: r[k] for k in RESULT_FIELDS if k != "steps"},
+                       "steps": len(r["steps"])}
+                f.write(json.dumps(row) + "\n")
+                f.flush()
+                os.fsync(f.fileno())
+                done[keys[i]] = row
+                finished += 1
+                if progress:
+                    progress(finished, total)
+                nxt = next(pending, None)
+                if nxt is not None:
+                    fut = client.submit(episode_task, configs[nxt], pure=False)
+                    futures[fut] = nxt
+                    queue.add(fut)
+    rows = [done[k] for k in keys]
+    return write_outputs(out, base, axes, points, configs, rows, code)
+
+
+def write_outputs(out: Path, base: EpisodeConfig, axes: list[Axis], points: list[dict[str, float]],
+                  configs: list[dict[str, Any]], rows: list[dict[str, Any]], code: dict[str, Any]) -> dict[str, Any]:
+    from analysis.figures import grid_slices_figure
+    from drake_biped.learning import write_atomic
+
+    best = None
+    for i, row in enumerate(rows):
+        if better(row, rows[best] if best is not None else None):
+            best = i
+    names = [a.name for a in axes]
+    with open(out / "grid.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([*names, *RESULT_FIELDS])
+        for p, row in zip(points, rows):
+            writer.writerow([p[n] for n in names] + [row[k] for k in RESULT_FIELDS])
+    best_config = configs[best]
+    write_atomic(out / "best_params.json", best_config)
+    walked = [r for r in rows if not r["fell"] and r["distance_m"] >= base.sim.distance_m - 1e-6]
+    record = {
+        "base_config": base.to_dict(),
+        "axes": [{"name": a.name, "values": list(a.values)} for a in axes],
+        "points": len(rows),
+        "walked_the_distance": len(walked),
+        "best": {"point": points[best], **{k: rows[best][k] for k in RESULT_FIELDS}},
+        "versions": code,
+    }
+    write_atomic(out / "grid.json", record)
+    grid_slices_figure(axes, points, rows, points[best], out / "grid_slices.png", base.sim.distance_m)
+    return record

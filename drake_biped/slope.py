@@ -1,0 +1,251 @@
+"""Slope adaptation (SPEC §6.4, the paper's Figs. 8-11), on Dask.
+
+The ground is level for `level_length_m` (2 m), then ascends at `slope_rad`. An episode *climbs* when it
+reaches the episode's distance (10 m: 2 m level, 8 m up) without falling. Three questions, each answered by
+episodes on that ground:
+
+1. Does the torque-free period learned on level ground climb? (one episode with the starting policy's mean)
+2. Does the gait without a torque-free period climb? (one episode)
+3. Online GARB learning on the slope, starting from the learned policy: does it shrink the period until it
+   climbs? (`trials` independent runs of `episodes` each; then one episode with each final policy mean)
+
+The learner starts from the learned policy's state: its mean, variance and eligibility trace. The paper
+says "the learning algorithm and α_p were not changed"; here the episode count starts again at 1 on the new
+ground, so α_p follows Table II from its first band (carrying the count over would leave α_p at 0.001 after
+a 500-episode level run, and the period could not move in tens of episodes), and the baseline becomes the
+running mean of the slope's rewards. Reward and fall rule are the level run's (`learning.reward`).
+
+Nothing lost: the learning runs through `learning.run_learning` (each trial's record rewritten after every
+episode, resumed on rerun) and the check episodes are kept in OUT/checks/ and reused.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.garb import GarbLearner
+from drake_biped.learning import make_settings, run_learning, trial_seed, window_of, write_atomic
+from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow
+from drake_biped.versions import versions
+
+MOVING_AVERAGE = 20  # episodes, as in the paper's Figs. 8-11
+
+
+def slope_ground(slope_rad: float, level_length_m: float = 2.0, friction: float = 1.0) -> Ground:
+    if not (math.isfinite(slope_rad) and slope_rad > 0):
+        raise ParameterError(f"--slope {slope_rad!r}: must be > 0 (an ascending slope, rad)")
+    return Ground(slope_rad=slope_rad, level_length_m=level_length_m, friction=friction)
+
+
+def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The learner state of a level-ground run's best learned trial (`learning.best_learned_trial`), read
+    from its record OUT/trials/trial_K.json beside the learning.json; and a description of where it came
+    from."""
+    from drake_biped.learning import best_learned_trial
+
+    if not path.is_file():
+        raise ParameterError(f"--policy: no such file: {path}")
+    try:
+        record = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"--policy {path}: not valid JSON ({exc})") from None
+    row = best_learned_trial(record, f"--policy {path}")
+    trial_path = path.parent / "trials" / f"trial_{row['trial']}.json"
+    try:
+        state = json.loads(trial_path.read_text())["learner"]
+        GarbLearner.from_state(state)
+    except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+        raise ParameterError(f"--policy {path}: cannot read trial {row['trial']}'s learner state from "
+                             f"{trial_path} ({exc})") from None
+    source = {"learning": str(path), "trial": row["trial"], "level_cost_of_transport": row["cost_of_transport"],
+              "level_episodes": state["episodes"]}
+    return state, source
+
+
+def start_from_window(t1: float, t2: float, variance: float) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A fresh learner state with mean (t1, t2): for a slope run without a level-ground learning record.
+    (Its generator is never drawn from: each slope trial gets its own; seed 0 keeps the state reproducible.)"""
+    return GarbLearner((t1, t2), variance, seed=0).state(), {"window": [t1, t2], "variance": variance}
+
+
+def _check_path(out: Path, name: str) -> Path:
+    return out / "checks" / f"{name}.json"
+
+
+def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[str, dict[str, Any]]:
+    """One episode per named configuration, kept in OUT/checks/ and reused when its configuration matches."""
+    from drake_biped.parallel import episode_task
+
+    (out / "checks").mkdir(parents=True, exist_ok=True)
+    results, futures = {}, {}
+    for name, config in configs.items():
+        path = _check_path(out, name)
+        if path.is_file():
+            saved = json.loads(path.read_text())
+            if saved.get("config") == config.to_dict():
+                results[name] = saved
+                continue
+        futures[name] = client.submit(episode_task, config.to_dict(), pure=False)
+    for name, future in futures.items():
+        r = future.result()
+        r.pop("task_wall_time_s", None)
+        r.pop("worker_peak_rss_mb", None)
+        write_atomic(_check_path(out, name), r)
+        results[name] = r
+    return results
+
+
+def climbs(result: dict[str, Any]) -> bool:
+    """The episode reached its distance without falling."""
+    return bool((not result["fell"]) and result["distance_m"] >= result["config"]["sim"]["distance_m"] - 1e-6)
+
+
+def _summary(result: dict[str, Any]) -> dict[str, Any]:
+    keep = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps")
+    return {**{k: result[k] for k in keep}, "climbs": climbs(result)}
+
+
+def period(t1: float, t2: float) -> float:
+    """Length of the torque-free period a (t1, t2) sample or mean gives: t2 - t1 with times below 0 acting
+    as 0, and 0 when t2 <= t1."""
+    return float(max(0.0, max(0.0, t2) - max(0.0, t1)))
+
+
+def moving_average(x: np.ndarray, n: int = MOVING_AVERAGE) -> np.ndarray:
+    """Trailing average over the last min(n, i + 1) values."""
+    c = np.cumsum(np.insert(np.asarray(x, dtype=float), 0, 0.0))
+    i = np.arange(1, len(x) + 1)
+    lo = np.maximum(0, i - n)
+    return (c[i] - c[lo]) / (i - lo)
+
+
+def trial_summary(episodes: list[dict[str, Any]], distance_m: float, start_period_s: float) -> dict[str, Any]:
+    """How one trial's sampled periods and distances developed: first and last 20-episode averages, the
+    share of climbing episodes among the last 20, and the first episode whose 20-episode average distance
+    is the full distance (None if never)."""
+    d = np.array([e["distance_m"] for e in episodes])
+    p = np.array([period(e["t1"], e["t2"]) for e in episodes])
+    mean_p = np.array([period(e["mean_t1"], e["mean_t2"]) for e in episodes])
+    up = np.array([(not e["fell"]) and e["distance_m"] >= distance_m - 1e-6 for e in episodes])
+    n = min(MOVING_AVERAGE, len(episodes))
+    ma = moving_average(d)
+    reached = np.flatnonzero(ma >= distance_m - 1e-6)
+    return {
+        "episodes": len(episodes),
+        "period_first_s": float(p[:n].mean()),
+        "period_last_s": float(p[-n:].mean()),
+        "mean_period_start_s": start_period_s,
+        "mean_period_end_s": float(mean_p[-1]),
+        "distance_first_m": float(d[:n].mean()),
+        "distance_last_m": float(d[-n:].mean()),
+        "climb_share_last": float(up[-n:].mean()),
+        "first_full_average_episode": int(reached[0]) + 1 if reached.size else None,
+    }
+
+
+def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[str, Any],
+              start_source: dict[str, Any], trials: int, episodes: int, seed: int, client,
+              progress: Callable[[int, int, float | None], None] | None = None) -> dict[str, Any]:
+    """Run (or finish) the checks and the online learning on the slope; write slope.json and the figures;
+    return the record."""
+    from analysis.figures import slope_figures
+
+    code = versions()
+    out.mkdir(parents=True, exist_ok=True)
+    config = base.replace(ground=ground, window=TorqueFreeWindow(0.0, 0.0), seed=seed)
+    start = GarbLearner.from_state(start_state)
+    settings = make_settings(config, trials, episodes, seed, mean=tuple(start.mean), variance=start.variance,
+                             beta=start.beta, schedule=start.schedule)
+    settings["learner"]["start_state"] = start_state
+    checks = _run_checks(out, {"start_window": config.replace(window=window_of(start.mean)),
+                               "no_window": config}, client)
+    runs, _ = run_learning(out, settings, client, progress)
+    finals = _run_checks(out, {f"final_trial_{t.index}": config.replace(window=window_of(t.learner.mean))
+                               for t in runs}, client)
+    start_period = period(*start.mean)
+    trial_rows = []
+    for t in runs:
+        row = {"trial": t.index, "learner_seed": trial_seed(seed, t.index), "final_mean": t.learner.mean.tolist(),
+               **trial_summary(t.episodes, config.sim.distance_m, start_period),
+               "final_policy": _summary(finals[f"final_trial_{t.index}"])}
+        trial_rows.append(row)
+    record = {
+        "settings": settings,
+        "ground": ground.to_dict(),
+        "start": {**start_source, "mean": start.mean.tolist(), "period_s": start_period,
+                  "variance": start.variance},
+        "checks": {name: _summary(r) for name, r in checks.items()},
+        "trials": trial_rows,
+        "episodes": [{"trial": t.index, "episodes": t.episodes} for t in runs],
+        "verdicts": verdicts(_summary(checks["start_window"]), _summary(checks["no_window"]), trial_rows,
+                             start_period),
+        "versions": code,
+    }
+    write_atomic(out / "slope.json", record)
+    (out / "report.md").write_text(report_markdown(record))
+    slope_figures(record, out)
+    return record
+
+
+def verdicts(start: dict[str, Any], none: dict[str, Any], trials: list[dict[str, Any]],
+             start_period: float) -> dict[str, Any]:
+    """The paper's three claims about the slope, each True/False as measured here."""
+    adapted = [t for t in trials if t["final_policy"]["climbs"] and t["mean_period_end_s"] < start_period]
+    return {
+        "learned_period_fails_to_climb": (not start["climbs"]) and start_period > 0,
+        "no_period_climbs": none["climbs"],
+        "learning_shrinks_the_period_until_it_climbs": len(adapted),
+        "trials": len(trials),
+    }
+
+
+def report_markdown(record: dict[str, Any]) -> str:
+    """The slope run in words and numbers: the two checks, each trial's development, the verdicts."""
+    g, start, checks, v = record["ground"], record["start"], record["checks"], record["verdicts"]
+
+    def episode(r: dict[str, Any]) -> str:
+        how = "climbs" if r["climbs"] else (f"falls ({r['fall_reason']})" if r["fell"] else "stops")
+        cmt = "" if r["cost_of_transport"] is None else f", C_mt {r['cost_of_transport']:.3f}"
+        return f"{how}: {r['distance_m']:.2f} m in {r['duration_s']:.1f} s{cmt}"
+
+    t1, t2 = start["mean"]
+    origin = (f"trial {start['trial']} of {start['learning']} (after {start['level_episodes']} level-ground "
+              f"episodes)" if "learning" in start else "the given window (no level-ground learning record)")
+    lines = [
+        f"# Slope adaptation: {g['level_length_m']:g} m level, then {g['slope_rad']:g} rad "
+        f"({math.degrees(g['slope_rad']):.2f}°)",
+        "",
+        f"Starting policy: mean t1 = {t1:.3f} s, t2 = {t2:.3f} s (period {start['period_s']:.3f} s), variance "
+        f"{start['variance']:g} s², from {origin}.",
+        "",
+        "| claim (paper) | measured here | holds |",
+        "|---|---|---|",
+        f"| the learned torque-free period fails to climb | {episode(checks['start_window'])} | "
+        f"{'yes' if v['learned_period_fails_to_climb'] else 'no'} |",
+        f"| without a torque-free period the robot climbs | {episode(checks['no_window'])} | "
+        f"{'yes' if v['no_period_climbs'] else 'no'} |",
+        f"| online learning shrinks the period until it climbs | {v['learning_shrinks_the_period_until_it_climbs']}"
+        f" of {v['trials']} trials end with a shorter period that climbs | "
+        f"{'yes' if v['learning_shrinks_the_period_until_it_climbs'] else 'no'} |",
+        "",
+        f"| trial | episodes | period, first / last {MOVING_AVERAGE} (s) | policy period end (s) | distance, first "
+        f"/ last {MOVING_AVERAGE} (m) | climbs in last {MOVING_AVERAGE} | first full {MOVING_AVERAGE}-average | "
+        "final policy |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for t in record["trials"]:
+        first = t["first_full_average_episode"]
+        lines.append(
+            f"| {t['trial']} | {t['episodes']} | {t['period_first_s']:.3f} / {t['period_last_s']:.3f} | "
+            f"{t['mean_period_end_s']:.3f} | {t['distance_first_m']:.2f} / {t['distance_last_m']:.2f} | "
+            f"{100 * t['climb_share_last']:.0f} % | {'never' if first is None else f'episode {first}'} | "
+            f"({t['final_mean'][0]:.3f}, {t['final_mean'][1]:.3f}): {episode(t['final_policy'])} |")
+    lines += ["", "Figures: fig8_period.png (the paper's Fig. 8, or Fig. 10 at 2.0°), fig9_distance.png "
+              "(Fig. 9 / Fig. 11).", ""]
+    return "\n".join(lines)
