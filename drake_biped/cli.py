@@ -395,6 +395,33 @@ def cmd_push_margin(args: argparse.Namespace) -> int:
     return 0
 
 
+class _RunProgress:
+    """A progress bar and the run log OUT/run.json (`learning.SessionLog`: each session's count and wall
+    time) for a resumable run; called as progress(done, total, ...) by the run as it goes."""
+
+    def __init__(self, out: Path, args: argparse.Namespace, desc: str, unit: str):
+        from tqdm import tqdm
+
+        from drake_biped.learning import SessionLog
+
+        out.mkdir(parents=True, exist_ok=True)
+        self.log = SessionLog(out / "run.json", args.workers, args.scheduler)
+        self.bar = tqdm(total=0, desc=desc, unit=unit)
+        self.first: int | None = None
+
+    def __call__(self, done: int, total: int, *_) -> None:
+        if self.first is None:
+            self.first = done
+        self.log.update(done - self.first)
+        self.bar.total = total
+        self.bar.n = done
+        self.bar.refresh()
+
+    def close(self) -> None:
+        self.bar.close()
+        self.log.update(0 if self.first is None else self.bar.n - self.first, finished=True)
+
+
 def cmd_grid(args: argparse.Namespace) -> int:
     from drake_biped.grid import load_spec, run_grid, table_iv_axes
     from drake_biped.parallel import dask_client
@@ -405,20 +432,12 @@ def cmd_grid(args: argparse.Namespace) -> int:
         raise ParameterError("give either --spec or --points-per-axis, not both")
     axes = load_spec(Path(args.spec)) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
     out = Path(args.out)
-    from tqdm import tqdm
-
-    bar = tqdm(total=0, desc="grid", unit="point")
-
-    def progress(done: int, total: int) -> None:
-        bar.total = total
-        bar.n = done
-        bar.refresh()
-
+    progress = _RunProgress(out, args, "grid", "point")
     try:
         with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
             record = run_grid(out, config, axes, client, progress)
     finally:
-        bar.close()
+        progress.close()
     best = record["best"]
     cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
     print(f"{record['walked_the_distance']}/{record['points']} points walk {config.sim.distance_m:g} m; best "
@@ -428,7 +447,6 @@ def cmd_grid(args: argparse.Namespace) -> int:
 
 
 def cmd_slope(args: argparse.Namespace) -> int:
-    from drake_biped.learning import SessionLog
     from drake_biped.parallel import dask_client
     from drake_biped.slope import run_slope, slope_ground, start_from_learning, start_from_window
 
@@ -447,27 +465,13 @@ def cmd_slope(args: argparse.Namespace) -> int:
     else:
         state, source = start_from_window(*_chosen_window(args), args.variance)
     out = Path(args.out)
-    from tqdm import tqdm
-
-    bar = tqdm(total=args.trials * args.episodes, desc="slope learning", unit="episode")
-    out.mkdir(parents=True, exist_ok=True)
-    log = SessionLog(out / "run.json", args.workers, args.scheduler)
-    first: list[int] = []
-
-    def progress(done: int, total: int, latest: float | None) -> None:
-        if not first:
-            first.append(done)
-        log.update(done - first[0])
-        bar.n = done
-        bar.refresh()
-
+    progress = _RunProgress(out, args, "slope learning", "episode")
     try:
         with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
             run_slope(out, config, ground, state, source, args.trials, args.episodes, config.seed,
                       client, progress)
     finally:
-        bar.close()
-    log.update(0 if not first else bar.n - first[0], finished=True)
+        progress.close()
     print((out / "report.md").read_text())
     print(f"wrote {out}/slope.json, report.md, fig8_period.png, fig9_distance.png")
     return 0

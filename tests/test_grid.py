@@ -124,6 +124,8 @@ def test_tiny_grid_finds_the_walking_point_and_a_rerun_recomputes_nothing(tmp_pa
     lines = (out / "points.jsonl").read_text().splitlines()
     assert len(lines) == 3 and len(read_points(out / "points.jsonl")) == 2  # the half line, skipped
     assert json.loads((out / "grid.json").read_text()) == record
+    # The run log counts what each session computed: 2 points, then none, then the one lost.
+    assert [x["episodes"] for x in json.loads((out / "run.json").read_text())["sessions"]] == [2, 0, 1]
     assert "1/2 points walk 1.2 m" in capsys.readouterr().out
 
 
