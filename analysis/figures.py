@@ -317,7 +317,8 @@ def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, p
     else:
         cols = min(4, len(pairs))
         nrows = -(-len(pairs) // cols)
-        fig, grid = plt.subplots(nrows, cols, figsize=(3.3 * cols, 2.9 * nrows), squeeze=False)
+        fig, grid = plt.subplots(nrows, cols, figsize=(3.0 * cols + 1.0, 2.6 * nrows + 0.4), squeeze=False,
+                                 layout="constrained")
         image = None
         for ax, (a, b) in zip(grid.flat, pairs):
             z = np.array([[distance({a.name: va, b.name: vb}) for va in a.values] for vb in b.values])
@@ -329,7 +330,7 @@ def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, p
             ax.plot(a.values.index(best[a.name]), b.values.index(best[b.name]), "r*", ms=9)
         for ax in list(grid.flat)[len(pairs):]:
             ax.axis("off")
-        fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.8, label="walking distance (m)")
+        fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.9, label="walking distance (m)")
     fixed = ", ".join(f"{short[a.name]}={best[a.name]:.3g}" for a in axes)
     fig.suptitle(f"Grid search: distance walked, slices through the best point (red star: {fixed})", fontsize=9)
     fig.savefig(path, dpi=110)

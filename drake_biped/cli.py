@@ -597,8 +597,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "and does online GARB learning adapt it (Figs. 8-11), on Dask")
     _add_episode_options(sl)
     _add_window_options(sl)
-    sl.add_argument("--variance", type=_number("positive"), default=0.01,
-                    help="the policy's variance (s^2) when starting from --t1/--t2; default 0.01 "
+    sl.add_argument("--variance", type=_number("positive"), default=0.04,
+                    help="the policy's variance (s^2) when starting from --t1/--t2; default 0.04 as in the paper "
                     "(--policy carries its own)")
     sl.add_argument("--episodes", type=_count, default=100, help="learning episodes per trial (default 100)")
     sl.add_argument("--trials", type=_count, default=2, help="independent learning trials (default 2)")
