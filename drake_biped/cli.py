@@ -71,12 +71,9 @@ def _add_episode_options(p: argparse.ArgumentParser) -> None:
 def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     config = EpisodeConfig()
     if args.params is not None:
-        if not args.params.is_file():
-            raise ParameterError(f"--params: no such file: {args.params}")
-        try:
-            data = json.loads(args.params.read_text())
-        except json.JSONDecodeError as exc:
-            raise ParameterError(f"--params {args.params}: not valid JSON ({exc})") from None
+        from drake_biped.learning import read_json
+
+        data = read_json(args.params, "--params")
         if isinstance(data, dict) and "config" in data:  # a result.json: reuse the config that made it
             data = data["config"]
         config = EpisodeConfig.from_dict(data)
@@ -249,16 +246,10 @@ def cmd_learn(args: argparse.Namespace) -> int:
 
 def cmd_figures(args: argparse.Namespace) -> int:
     from analysis.figures import learning_figures
+    from drake_biped.learning import read_json
 
     out = Path(args.dir)
-    path = out / "learning.json"
-    if not path.is_file():
-        raise ParameterError(f"figures: no learning.json in {out}")
-    try:
-        record = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"figures: {path} is not valid JSON ({exc})") from None
-    for p in learning_figures(record, out):
+    for p in learning_figures(read_json(out / "learning.json", "figures: learning record"), out):
         print(f"wrote {p}")
     return 0
 
@@ -297,15 +288,9 @@ def cmd_landscape(args: argparse.Namespace) -> int:
 
 def _policy_window(path: Path) -> tuple[float, float]:
     """The learned torque-free period of a learning.json (`learning.best_learned_trial`)."""
-    from drake_biped.learning import best_learned_trial
+    from drake_biped.learning import best_learned_trial, read_json
 
-    if not path.is_file():
-        raise ParameterError(f"--policy: no such file: {path}")
-    try:
-        record = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"--policy {path}: not valid JSON ({exc})") from None
-    row = best_learned_trial(record, f"--policy {path}")
+    row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
     return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
 
 

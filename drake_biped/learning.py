@@ -71,6 +71,16 @@ def write_atomic(path: Path, data: dict) -> None:
     os.replace(tmp, path)
 
 
+def read_json(path: Path, what: str) -> Any:
+    """The JSON in `path`, or ParameterError naming `what` (the option or command that gave the path)."""
+    if not path.is_file():
+        raise ParameterError(f"{what}: no such file: {path}")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"{what} {path}: not valid JSON ({exc})") from None
+
+
 def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
     """The settings a trial's record must share with the command resuming it: all but how many trials and
     episodes (a run may be extended; the schedule depends on the episode number only)."""

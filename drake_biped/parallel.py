@@ -89,6 +89,45 @@ def episode_task(config: dict[str, Any], kick: dict[str, float] | None = None) -
     return result
 
 
+def run_kept(
+    client: Any,
+    jobs: dict[Any, tuple[Any, dict[str, Any]]],
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[Any, dict[str, Any]]:
+    """One episode per job {key: (path, EpisodeConfig dict)}, each result kept at its path (atomically):
+    a result already there for the same configuration is read back instead of run. Results by key;
+    progress(done, total) as they come."""
+    import json
+
+    from distributed import as_completed
+
+    from drake_biped.learning import write_atomic
+
+    results: dict[Any, dict[str, Any]] = {}
+    todo = {}
+    for key, (path, config) in jobs.items():
+        if path.is_file():
+            saved = json.loads(path.read_text())
+            if saved.get("config") == config:
+                results[key] = saved
+                continue
+        todo[key] = (path, config)
+    if progress:
+        progress(len(results), len(jobs))
+    futures = {client.submit(episode_task, config, pure=False): key for key, (_, config) in todo.items()}
+    for future in as_completed(list(futures)):
+        key = futures[future]
+        r = future.result()
+        r.pop("task_wall_time_s", None)
+        r.pop("worker_peak_rss_mb", None)
+        todo[key][0].parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(todo[key][0], r)
+        results[key] = r
+        if progress:
+            progress(len(results), len(jobs))
+    return results
+
+
 def map_ordered(
     client: Any,
     fn: Callable[[Any], Any],

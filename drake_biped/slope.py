@@ -47,15 +47,9 @@ def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
     """The learner state of a level-ground run's best learned trial (`learning.best_learned_trial`), read
     from its record OUT/trials/trial_K.json beside the learning.json; and a description of where it came
     from."""
-    from drake_biped.learning import best_learned_trial
+    from drake_biped.learning import best_learned_trial, read_json
 
-    if not path.is_file():
-        raise ParameterError(f"--policy: no such file: {path}")
-    try:
-        record = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"--policy {path}: not valid JSON ({exc})") from None
-    row = best_learned_trial(record, f"--policy {path}")
+    row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
     trial_path = path.parent / "trials" / f"trial_{row['trial']}.json"
     try:
         state = json.loads(trial_path.read_text())["learner"]
@@ -74,31 +68,11 @@ def start_from_window(t1: float, t2: float, variance: float) -> tuple[dict[str, 
     return GarbLearner((t1, t2), variance, seed=0).state(), {"window": [t1, t2], "variance": variance}
 
 
-def _check_path(out: Path, name: str) -> Path:
-    return out / "checks" / f"{name}.json"
-
-
 def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[str, dict[str, Any]]:
     """One episode per named configuration, kept in OUT/checks/ and reused when its configuration matches."""
-    from drake_biped.parallel import episode_task
+    from drake_biped.parallel import run_kept
 
-    (out / "checks").mkdir(parents=True, exist_ok=True)
-    results, futures = {}, {}
-    for name, config in configs.items():
-        path = _check_path(out, name)
-        if path.is_file():
-            saved = json.loads(path.read_text())
-            if saved.get("config") == config.to_dict():
-                results[name] = saved
-                continue
-        futures[name] = client.submit(episode_task, config.to_dict(), pure=False)
-    for name, future in futures.items():
-        r = future.result()
-        r.pop("task_wall_time_s", None)
-        r.pop("worker_peak_rss_mb", None)
-        write_atomic(_check_path(out, name), r)
-        results[name] = r
-    return results
+    return run_kept(client, {name: (out / "checks" / f"{name}.json", c.to_dict()) for name, c in configs.items()})
 
 
 def climbs(result: dict[str, Any]) -> bool:

@@ -183,39 +183,14 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
                   jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD) -> dict[str, Any]:
     """Run (or finish) the six cells on Dask, then the finite-difference Jacobian of each condition's step
     map at each kick size, and return the stability record. Finished parts are read back on a rerun."""
-    from distributed import as_completed
-
     from drake_biped.learning import write_atomic
-    from drake_biped.parallel import episode_task
+    from drake_biped.parallel import run_kept
 
     code = versions()  # recorded at the start: the code this process runs
     (out / "episodes").mkdir(parents=True, exist_ok=True)
-    jobs = cell_configs(base, settings)
-    results: dict[tuple[str, str, int], dict[str, Any]] = {}
-    todo = []
-    for condition, kind, k, config in jobs:
-        path = _result_path(out, condition, kind, k)
-        cfg = config.to_dict()
-        if path.is_file():
-            saved = json.loads(path.read_text())
-            if saved.get("config") == cfg:
-                results[(condition, kind, k)] = saved
-                continue
-        todo.append((condition, kind, k, cfg))
-    total, done = len(jobs), len(results)
-    if progress:
-        progress(done, total)
-    futures = {client.submit(episode_task, cfg, pure=False): (c, kd, k) for c, kd, k, cfg in todo}
-    for future in as_completed(list(futures)):
-        key = futures[future]
-        r = future.result()
-        r.pop("task_wall_time_s", None)
-        r.pop("worker_peak_rss_mb", None)
-        write_atomic(_result_path(out, *key), r)
-        results[key] = r
-        done += 1
-        if progress:
-            progress(done, total)
+    jobs = {(c, kind, k): (_result_path(out, c, kind, k), config.to_dict())
+            for c, kind, k, config in cell_configs(base, settings)}
+    results = run_kept(client, jobs, progress)
     jacobian: dict[str, list[dict[str, Any]]] = {}
     for condition in CONDITIONS:
         window = condition_window(condition, settings.window)
