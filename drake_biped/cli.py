@@ -571,7 +571,8 @@ def build_parser() -> argparse.ArgumentParser:
     grid = sub.add_parser("grid", help="grid search of CPG parameters and the initiation (Table IV), on Dask")
     _add_episode_options(grid)
     grid.add_argument("--points-per-axis", type=_count, default=None,
-                      help="points per Table IV range (cell centres); default 2 (32 points)")
+                      help="points per range (cell centres) of Table IV's five CPG parameters and the "
+                      "initial hip angle (0-15.2 deg) and speed (0-0.35 m/s); default 2 (128 points)")
     grid.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
                       "{values: [...]}}; see grids/")
     _add_cluster_options(grid)

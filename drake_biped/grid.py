@@ -4,7 +4,8 @@ Every grid point is one episode (walk until a fall or the distance) of the base 
 point's values put in. The axes are dotted EpisodeConfig fields (`cpg.u_a`, `initial.speed_mps`,
 `gait.torso_pitch_rad`, ...) or the short names of Table IV (alpha, u_a, u_eta, u_r, kappa) and of the
 initiation (hip_angle, speed). A range of K points is split into K equal cells with a point at the centre
-of each (K = 1: the middle), so no point sits on an edge where the CPG stops (u_r = 0).
+of each (K = 1: the middle), so no point sits on an edge where the CPG stops (u_r = 0). Without a spec
+the grid is Table IV's five ranges and the initiation's (`INITIATION_RANGES`), K points each.
 
 The best point walks furthest (to the centimetre); among points that go equally far, the lowest C_mt wins.
 It is written as a parameter file that every command accepts (`--params DIR/best_params.json`).
@@ -37,6 +38,12 @@ TABLE_IV: dict[str, tuple[float, float]] = {
     "u_eta": (-1.0, 1.0),
     "u_r": (0.0, 3.0),
     "kappa": (0.0, 2.0),
+}
+# The initiation's ranges (the paper searched it too but prints no range): from standing still with the
+# legs together to twice the paper's 7.6 deg and 0.175 m/s.
+INITIATION_RANGES: dict[str, tuple[float, float]] = {
+    "hip_angle": (0.0, 2 * math.radians(7.6)),
+    "speed": (0.0, 2 * 0.175),
 }
 SHORT_NAMES = {
     "alpha": "cpg.alpha",
@@ -90,8 +97,9 @@ def cell_centres(lo: float, hi: float, points: int) -> tuple[float, ...]:
 
 
 def table_iv_axes(points_per_axis: int) -> list[Axis]:
-    """Table IV's five CPG ranges, `points_per_axis` cell centres each."""
-    return [Axis(field_name(n), cell_centres(lo, hi, points_per_axis)) for n, (lo, hi) in TABLE_IV.items()]
+    """Table IV's five CPG ranges and the initiation's two, `points_per_axis` cell centres each."""
+    ranges = {**TABLE_IV, **INITIATION_RANGES}
+    return [Axis(field_name(n), cell_centres(lo, hi, points_per_axis)) for n, (lo, hi) in ranges.items()]
 
 
 def parse_spec(spec: Any, source: str = "grid spec") -> list[Axis]:

@@ -8,6 +8,7 @@ import pytest
 
 from drake_biped.cli import main
 from drake_biped.grid import (
+    INITIATION_RANGES,
     TABLE_IV,
     Axis,
     better,
@@ -34,14 +35,19 @@ def test_cell_centres_split_the_range_evenly_and_stay_off_its_edges():
 
 def test_table_iv_grid_covers_the_papers_ranges_with_valid_configurations():
     axes = table_iv_axes(2)
-    assert [a.name for a in axes] == ["cpg.alpha", "cpg.u_a", "cpg.u_eta", "cpg.u_r", "cpg.kappa"]
+    assert [a.name for a in axes] == ["cpg.alpha", "cpg.u_a", "cpg.u_eta", "cpg.u_r", "cpg.kappa",
+                                      "initial.hip_angle_rad", "initial.speed_mps"]
     points = grid_points(axes)
-    assert len(points) == 2**5
-    for a, (lo, hi) in zip(axes, TABLE_IV.values()):
+    assert len(points) == 2**7
+    for a, (lo, hi) in zip(axes, [*TABLE_IV.values(), *INITIATION_RANGES.values()]):
         assert all(lo < v < hi for v in a.values)
+    # The initiation's ranges are centred on the paper's 7.6 deg and 0.175 m/s.
+    assert sum(axes[5].values) / 2 == pytest.approx(math.radians(7.6))
+    assert sum(axes[6].values) / 2 == pytest.approx(0.175)
     for p in points:  # every point is a configuration the toolkit accepts (u_r > 0 included)
-        c = point_config(EpisodeConfig(), p).cpg
-        assert (c.alpha, c.u_a, c.u_eta, c.u_r, c.kappa) == tuple(p.values())
+        c = point_config(EpisodeConfig(), p)
+        assert (c.cpg.alpha, c.cpg.u_a, c.cpg.u_eta, c.cpg.u_r, c.cpg.kappa, c.initial.hip_angle_rad,
+                c.initial.speed_mps) == tuple(p.values())
 
 
 def test_points_are_every_combination_with_the_last_axis_fastest():
