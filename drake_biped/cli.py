@@ -116,16 +116,7 @@ def _progress_bar(total_m: float, desc: str):
 
 
 def cmd_walk(args: argparse.Namespace) -> int:
-    from analysis.figures import walk_animation, walk_figure
-    from drake_biped.diagram import build_diagram
-    from drake_biped.episode import run_episode
-    from drake_biped.outputs import (
-        GraphvizMissingError,
-        export_diagram,
-        start_meshcat,
-        warn,
-        write_meshcat_html,
-    )
+    from drake_biped.outputs import write_walk
 
     config = _episode_config(args)
     if (args.t1 is None) != (args.t2 is None):
@@ -135,34 +126,12 @@ def cmd_walk(args: argparse.Namespace) -> int:
     if args.push is not None:
         config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-
-    meshcat = None
-    if not args.no_animation:
-        meshcat = start_meshcat()
-        meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
     bar, update = _progress_bar(config.sim.distance_m, "walk")
     try:
-        result = run_episode(config, meshcat=meshcat, record_trajectory=True, progress=update)
-        update(result.duration_s, result.distance_m)  # the last report came up to 0.25 s before the end
+        result = write_walk(config, out, animation=not args.no_animation, save_trajectory=args.save_trajectory,
+                            progress=update)
     finally:
         bar.close()
-    result.to_json(out / "result.json")
-    if args.save_trajectory:
-        result.save_trajectory(out / "trajectory.npz")
-    try:
-        export_diagram(build_diagram(config).diagram, out)
-    except GraphvizMissingError as exc:
-        warn(str(exc))
-    window = config.window
-    title = (
-        f"C_mt {result.cost_of_transport:.3f}" if result.cost_of_transport is not None else "C_mt n/a"
-    ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
-    walk_figure(result.trajectory, out / "walk.png", title=title)
-    if meshcat is not None:
-        x = result.trajectory["positions"][:, 0]
-        write_meshcat_html(meshcat, out / "walk.html", x_range=(float(x.min()), float(x.max())))
-        walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
     _print_summary(result)
     print(f"wrote {out}/")
     return 0

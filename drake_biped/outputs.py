@@ -1,4 +1,5 @@
-"""Files a walk writes: the Drake diagram as SVG/PNG, a standalone Meshcat HTML recording."""
+"""Files a walk writes: its record, the Drake diagram as SVG/PNG, a standalone Meshcat HTML recording, the
+walk figure and GIF (`write_walk` writes them all)."""
 
 from __future__ import annotations
 
@@ -57,6 +58,42 @@ def write_meshcat_html(meshcat, path: Path, x_range: tuple[float, float] | None 
         distance = 0.65 * abs(x_range[1] - x_range[0]) + 2.0
         meshcat.SetCameraPose(np.array([x_mid, -distance, 0.9]), np.array([x_mid, 0.0, 0.35]))
     Path(path).write_text(meshcat.StaticHtml())
+
+
+def write_walk(config, out: Path, animation: bool = True, save_trajectory: bool = False, progress=None):
+    """Walk one episode of `config` and write into `out`: result.json, diagram.svg/.png (when Graphviz is
+    installed; a warning otherwise), walk.png, and with `animation` walk.html (Meshcat recording) and
+    walk.gif; trajectory.npz with `save_trajectory`. progress(t, distance) as it walks. The EpisodeResult."""
+    from analysis.figures import walk_animation, walk_figure
+    from drake_biped.diagram import build_diagram
+    from drake_biped.episode import run_episode
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    meshcat = None
+    if animation:
+        meshcat = start_meshcat()
+        meshcat.StartRecording(frames_per_second=30.0, set_visualizations_while_recording=False)
+    result = run_episode(config, meshcat=meshcat, record_trajectory=True, progress=progress)
+    if progress is not None:
+        progress(result.duration_s, result.distance_m)  # the last report came up to 0.25 s before the end
+    result.to_json(out / "result.json")
+    if save_trajectory:
+        result.save_trajectory(out / "trajectory.npz")
+    try:
+        export_diagram(build_diagram(config).diagram, out)
+    except GraphvizMissingError as exc:
+        warn(str(exc))
+    window = config.window
+    title = (
+        f"C_mt {result.cost_of_transport:.3f}" if result.cost_of_transport is not None else "C_mt n/a"
+    ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
+    walk_figure(result.trajectory, out / "walk.png", title=title)
+    if meshcat is not None:
+        x = result.trajectory["positions"][:, 0]
+        write_meshcat_html(meshcat, out / "walk.html", x_range=(float(x.min()), float(x.max())))
+        walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
+    return result
 
 
 def warn(message: str) -> None:
