@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin | grid | slope`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin | grid | slope | reproduce`.
 
 Every numeric option is validated here, at the boundary, with a message that names the option and value.
 """
@@ -431,6 +431,23 @@ def cmd_slope(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from drake_biped.reproduce import FULL, QUICK, Reproduction, check_out
+
+    _check_cluster_options(args)
+    profile = QUICK if args.quick else FULL
+    out = Path(args.out)
+    check_out(out, profile)
+    hours = profile.expected_minutes / 60
+    print(f"reproduce ({profile.name}): {len(Reproduction.STEPS)} experiments into {out}/, expected about "
+          + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.0f} h")
+          + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
+    Reproduction(out, profile, args.workers, args.scheduler).run_all()
+    print("\n".join(line for line in (out / "report.md").read_text().splitlines()[:40] if line.startswith("|")))
+    print(f"wrote {out}/report.md, report.html")
+    return 0
+
+
 def _steps(text: str) -> list[float]:
     parse = _number("positive")
     return [parse(t) for t in text.split(",")]
@@ -560,6 +577,13 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_options(sl)
     sl.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
     sl.set_defaults(func=cmd_slope)
+
+    rep = sub.add_parser("reproduce", help="every experiment of the paper and one report beside its numbers "
+                         "(--quick: small settings, minutes)")
+    rep.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
+    _add_cluster_options(rep)
+    rep.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    rep.set_defaults(func=cmd_reproduce)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")

@@ -96,10 +96,12 @@ def cell_centres(lo: float, hi: float, points: int) -> tuple[float, ...]:
     return tuple(round(lo + (k + 0.5) * width, 9) for k in range(points))
 
 
-def table_iv_axes(points_per_axis: int) -> list[Axis]:
-    """Table IV's five CPG ranges and the initiation's two, `points_per_axis` cell centres each."""
-    ranges = {**TABLE_IV, **INITIATION_RANGES}
-    return [Axis(field_name(n), cell_centres(lo, hi, points_per_axis)) for n, (lo, hi) in ranges.items()]
+def table_iv_axes(points_per_axis: int, initiation_points: int | None = None) -> list[Axis]:
+    """Table IV's five CPG ranges, `points_per_axis` cell centres each, and the initiation's two,
+    `initiation_points` each (default: as many)."""
+    k = points_per_axis if initiation_points is None else initiation_points
+    return ([Axis(field_name(n), cell_centres(lo, hi, points_per_axis)) for n, (lo, hi) in TABLE_IV.items()]
+            + [Axis(field_name(n), cell_centres(lo, hi, k)) for n, (lo, hi) in INITIATION_RANGES.items()])
 
 
 def parse_spec(spec: Any, source: str = "grid spec") -> list[Axis]:

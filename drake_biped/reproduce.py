@@ -1,0 +1,335 @@
+"""Reproduce the paper in one command (SPEC §6): every experiment, then one report beside the paper's numbers.
+
+`drake-biped reproduce --out DIR [--quick]` runs, each into its own folder of DIR and through the same
+functions as its own command:
+
+    walk/            the default gait, 10 m: record, figures, Meshcat HTML and GIF
+    time_step/       the time-step study
+    grid/            Table IV's grid (CPG ranges and the initiation), level ground; and Table III itself
+    window_map/      the default gait's torque-free windows against none
+    learn/           Experiment 1 with the paper's settings (Table V, Figs. 4-6)
+    learn_variant/   the same with exploration matched to the gait (start 0.4, 0.4; variance 0.01)
+    stability/       pushes and return maps, none vs 0.2-0.5 s (Table VI, Fig. 7)
+    push_margin/     the largest pushes survived, none vs 0.2-0.5 s
+    slope_default/   the default gait at the foot of 0.02 rad
+    grid_slope/      forward lean and placement on 0.02 rad; grid_slope2deg/ on 2.0 deg (our Table VII)
+    slope/, slope2deg/  the slope story with the climbing gaits (Figs. 8-11)
+
+then DIR/report.md and DIR/report.html: every table and figure with the paper's value beside ours and a
+verdict for each. `--quick` runs every experiment on small settings (minutes on 2 cores); the full run takes
+hours and says so up front.
+
+Nothing lost: each experiment keeps its finished work as its own command does (episodes, trials, grid
+points), and once done its summary in DIR/<name>/summary.json with the settings that made it; a rerun
+reuses every finished experiment and resumes the unfinished one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from drake_biped.params import PAPER_CPG, EpisodeConfig, InitialConditions, ParameterError, TorqueFreeWindow
+from drake_biped.versions import versions
+
+REPO = Path(__file__).resolve().parent.parent
+PARAMS_DIR = REPO / "params"
+LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none under pushes (as `stability` defaults)
+SLOPE_START = {"slope": (0.1, 0.6), "slope2deg": (0.1, 0.7)}  # each climbing gait's best level window
+PAPER_REDUCTION = 1.0 - 0.29 / 0.58
+TABLE_VII_PAPER = {"u_a": (2.0, 2.74), "u_r": (2.1, 2.63), "kappa": (1.8, 2.72)}  # Table III -> Table VII
+
+
+@dataclass(frozen=True)
+class Profile:
+    """How much of each experiment to run."""
+
+    name: str
+    distance_m: float  # level-ground episodes (the slopes always walk 10 m: 2 m level, 8 m up)
+    grid_points: int  # per Table IV range
+    grid_initiation_points: int
+    learn: tuple[int, int]  # trials, episodes
+    learn_variant: tuple[int, int]
+    window_step_s: float
+    stability_trials: int
+    jacobian: bool
+    margin_tolerance_n: float
+    slope: tuple[int, int]  # trials, episodes per slope
+    slope_grid_full: bool  # the whole slope grids, or 2 x 2 points through their bests
+    time_steps: tuple[float, ...]
+    time_step_distance_m: float
+    expected_minutes: float  # on 2 cores
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+QUICK = Profile("quick", 10.0, 2, 1, (2, 6), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
+                6.0)
+FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
+               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 240.0)
+
+
+def params_file(name: str) -> EpisodeConfig:
+    """A parameter file shipped in params/."""
+    path = PARAMS_DIR / name
+    try:
+        return EpisodeConfig.from_dict(json.loads(path.read_text()))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ParameterError(f"reproduce: cannot read the parameter file {path} ({exc})") from None
+
+
+class Reproduction:
+    """The output folder, the profile, the cluster options; runs each experiment once."""
+
+    def __init__(self, out: Path, profile: Profile, workers: int | None = None, scheduler: str | None = None,
+                 log: Callable[[str], None] = print):
+        self.out, self.profile, self.workers, self.scheduler, self.log = out, profile, workers, scheduler, log
+
+    @property
+    def level(self) -> EpisodeConfig:
+        """The default gait on level ground, walking the profile's distance."""
+        base = EpisodeConfig()
+        return base.replace(sim=dataclasses.replace(base.sim, distance_m=self.profile.distance_m,
+                                                    max_time_s=max(base.sim.max_time_s, 6 * self.profile.distance_m)))
+
+    def client(self):
+        from drake_biped.parallel import dask_client
+
+        return dask_client(workers=self.workers, scheduler=self.scheduler)
+
+    def experiment(self, name: str, settings: dict[str, Any], fn: Callable[[Path], dict[str, Any]]) -> dict:
+        """fn(folder) -> summary, unless DIR/name/summary.json holds one made with these settings."""
+        from drake_biped.learning import write_atomic
+
+        folder = self.out / name
+        path = folder / "summary.json"
+        if path.is_file():
+            saved = json.loads(path.read_text())
+            if saved.get("settings") == settings:
+                self.log(f"[{name}] finished earlier: reused")
+                return saved
+        self.log(f"[{name}] running")
+        t0 = time.perf_counter()
+        folder.mkdir(parents=True, exist_ok=True)
+        summary = {"settings": settings, **fn(folder)}
+        summary["wall_s"] = time.perf_counter() - t0
+        write_atomic(path, summary)
+        self.log(f"[{name}] done in {summary['wall_s']:.0f} s")
+        return summary
+
+    # The experiments, in the order they run. Each returns its summary (what the report needs).
+
+    def walk(self) -> dict:
+        from drake_biped.outputs import write_walk
+
+        def run(folder: Path) -> dict:
+            r = write_walk(self.level, folder)
+            return {"distance_m": r.distance_m, "fell": r.fell, "cost_of_transport": r.cost_of_transport,
+                    "mean_speed_mps": r.mean_speed_mps, "step_period_s": r.step_period_s,
+                    "real_time_factor": r.real_time_factor}
+
+        return self.experiment("walk", {"distance_m": self.profile.distance_m}, run)
+
+    def time_step(self) -> dict:
+        from drake_biped.time_step import run_study
+
+        p = self.profile
+        settings = {"steps": list(p.time_steps), "distance_m": p.time_step_distance_m}
+
+        def run(folder: Path) -> dict:
+            rec = run_study(folder, list(p.time_steps), 0.0005, p.time_step_distance_m, self.workers, self.scheduler)
+            return {"chosen_step_s": rec["chosen_step_s"], "passing_steps": rec["passing_steps"]}
+
+        return self.experiment("time_step", settings, run)
+
+    def grid(self) -> dict:
+        from drake_biped.grid import run_grid, table_iv_axes
+        from drake_biped.parallel import run_kept
+
+        p = self.profile
+        settings = {"points": p.grid_points, "initiation_points": p.grid_initiation_points,
+                    "distance_m": p.distance_m}
+
+        def run(folder: Path) -> dict:
+            axes = table_iv_axes(p.grid_points, p.grid_initiation_points)
+            table_iii = self.level.replace(cpg=PAPER_CPG, initial=InitialConditions())
+            with self.client() as client:
+                record = run_grid(folder, self.level, axes, client)
+                paper = run_kept(client, {"t": (folder / "table_iii.json", table_iii.to_dict())})["t"]
+            return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
+                    "table_iii": {"distance_m": paper["distance_m"], "fell": paper["fell"],
+                                  "steps": len(paper["steps"])}}
+
+        return self.experiment("grid", settings, run)
+
+    def window_map(self) -> dict:
+        from drake_biped.window_map import run_window_map
+
+        step = self.profile.window_step_s
+
+        def run(folder: Path) -> dict:
+            rec = run_window_map(self.level, folder, t1_step=step, t2_step=step, workers=self.workers or 2)
+            walked = [w for w in rec["windows"] if w["walked"]]
+            best = min(walked, key=lambda w: w["cost_of_transport"], default=None)
+            return {"no_window_cost_of_transport": rec["baseline"]["cost_of_transport"],
+                    "windows": len(rec["windows"]), "walked": len(walked),
+                    "best": None if best is None else {k: best[k] for k in ("t1", "t2", "cost_of_transport",
+                                                                             "cmt_change")}}
+
+        return self.experiment("window_map", {"step_s": step, "distance_m": self.profile.distance_m}, run)
+
+    def _learn(self, name: str, trials: int, episodes: int, mean, variance: float) -> dict:
+        from drake_biped.learning import learn, make_settings
+
+        settings = make_settings(self.level, trials, episodes, 0, mean=mean, variance=variance)
+
+        def run(folder: Path) -> dict:
+            record = learn(folder, settings, workers=self.workers, scheduler=self.scheduler)
+            ev = record["evaluation"]
+            run_log = json.loads((folder / "run.json").read_text())
+            return {"evaluation": ev, "episodes_per_min": run_log["episodes_per_min"]}
+
+        return self.experiment(name, {k: settings[k] for k in ("trials", "episodes", "learner", "config")}, run)
+
+    def learn(self) -> dict:
+        trials, episodes = self.profile.learn
+        return self._learn("learn", trials, episodes, (0.5, 0.5), 0.04)
+
+    def learn_variant(self) -> dict:
+        trials, episodes = self.profile.learn_variant
+        return self._learn("learn_variant", trials, episodes, (0.4, 0.4), 0.01)
+
+    def stability(self) -> dict:
+        from analysis.stability_report import write_stability_outputs
+        from drake_biped.learning import write_atomic
+        from drake_biped.stability import JACOBIAN_KICKS_RAD, StabilitySettings, run_stability
+
+        p = self.profile
+        settings = StabilitySettings(window=LEVEL_WINDOW, trials=p.stability_trials)
+
+        def run(folder: Path) -> dict:
+            with self.client() as client:
+                record = run_stability(folder, self.level, settings, client,
+                                       jacobian_kicks=JACOBIAN_KICKS_RAD if p.jacobian else ())
+            write_atomic(folder / "stability.json", record)
+            write_stability_outputs(record, folder)
+            cells = {c: {k: {key: record["cells"][c][k].get(key) for key in
+                             ("spectral_radius", "spectral_radius_ci", "eigenvalues", "falls", "trials", "stable",
+                              "paper_spectral_radius", "paper_eigenvalues")}
+                         for k in ("undisturbed", "forward", "backward")} for c in ("without", "with")}
+            return {"cells": cells}
+
+        return self.experiment("stability", {**settings.to_dict(), "jacobian": p.jacobian,
+                                             "distance_m": p.distance_m}, run)
+
+    def push_margin(self) -> dict:
+        from drake_biped.stability import push_margin
+
+        tol = self.profile.margin_tolerance_n
+
+        def run(folder: Path) -> dict:
+            with self.client() as client:
+                record = push_margin(self.level, LEVEL_WINDOW, client, max_force_n=200.0, tolerance_n=tol)
+            return {"margins": {c: {d: record["margins"][c][d]["survived_n"] for d in ("forward", "backward")}
+                                for c in ("without", "with")}}
+
+        return self.experiment("push_margin", {"tolerance_n": tol, "window": list(LEVEL_WINDOW),
+                                               "distance_m": self.profile.distance_m}, run)
+
+    def slope_default(self) -> dict:
+        from drake_biped.parallel import run_kept
+        from drake_biped.slope import climbs, slope_ground
+
+        def run(folder: Path) -> dict:
+            config = EpisodeConfig().replace(ground=slope_ground(0.02))
+            jobs = {"no_window": config, "window": config.replace(window=TorqueFreeWindow(*LEVEL_WINDOW))}
+            with self.client() as client:
+                results = run_kept(client, {k: (folder / f"{k}.json", c.to_dict()) for k, c in jobs.items()})
+            return {k: {"distance_m": r["distance_m"], "climbs": climbs(r)} for k, r in results.items()}
+
+        return self.experiment("slope_default", {"slope_rad": 0.02, "window": list(LEVEL_WINDOW)}, run)
+
+    def _slope_grid(self, name: str, spec: str, base_file: str | None, slope: float,
+                    subset: dict[str, list[float]]):
+        """A grid on 2 m level then `slope`, from the default gait (base_file None) or a params/ file: the
+        spec file in grids/ (full), or the 2 x 2 `subset` through its best (quick)."""
+        from drake_biped.grid import Axis, field_name, load_spec, run_grid
+        from drake_biped.slope import slope_ground
+
+        full = self.profile.slope_grid_full
+        settings = {"spec": spec if full else subset, "base": base_file, "slope_rad": slope}
+
+        def run(folder: Path) -> dict:
+            axes = load_spec(REPO / "grids" / spec) if full else [Axis(field_name(k), tuple(v))
+                                                                   for k, v in subset.items()]
+            base = (EpisodeConfig() if base_file is None else params_file(base_file)).replace(ground=slope_ground(slope))
+            with self.client() as client:
+                record = run_grid(folder, base, axes, client)
+            return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
+                    "base_cpg": base.cpg.to_dict()}
+
+        return self.experiment(name, settings, run)
+
+    def grid_slope(self) -> dict:
+        return self._slope_grid("grid_slope", "slope_0.02.yaml", None, 0.02,
+                                {"gait.torso_pitch_rad": [-0.2226, -0.30], "gait.placement_gain": [0.356, 0.45]})
+
+    def grid_slope2deg(self) -> dict:
+        return self._slope_grid("grid_slope2deg", "slope_2deg.yaml", "climbing_gait.json", 0.0349,
+                                {"gait.torso_pitch_rad": [-0.34, -0.38], "u_a": [1.6291, 2.0]})
+
+    def _slope(self, name: str, base_file: str, slope: float) -> dict:
+        from drake_biped.slope import run_slope, slope_ground, start_from_window
+
+        trials, episodes = self.profile.slope
+        t1, t2 = SLOPE_START[name]
+        settings = {"params": base_file, "slope_rad": slope, "start": [t1, t2], "variance": 0.04,
+                    "trials": trials, "episodes": episodes}
+
+        def run(folder: Path) -> dict:
+            state, source = start_from_window(t1, t2, 0.04)
+            source["params"] = f"params/{base_file}"
+            with self.client() as client:
+                record = run_slope(folder, params_file(base_file), slope_ground(slope), state, source, trials,
+                                   episodes, 0, client)
+            return {k: record[k] for k in ("checks", "verdicts", "trials", "start")}
+
+        return self.experiment(name, settings, run)
+
+    def slope(self) -> dict:
+        return self._slope("slope", "climbing_gait.json", 0.02)
+
+    def slope2deg(self) -> dict:
+        return self._slope("slope2deg", "climbing_gait_2deg.json", 0.0349)
+
+    STEPS = ("walk", "time_step", "grid", "window_map", "learn", "learn_variant", "stability", "push_margin",
+             "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
+
+    def run_all(self) -> dict[str, dict]:
+        self.out.mkdir(parents=True, exist_ok=True)
+        code = versions()
+        summaries = {}
+        for step in self.STEPS:
+            summaries[step] = getattr(self, step)()
+        from analysis.reproduce_report import write_report
+
+        write_report(self.out, summaries, self.profile, code)
+        return summaries
+
+
+def check_out(out: Path, profile: Profile) -> None:
+    """Refuse an output folder that holds another profile's run (its records would refuse to resume)."""
+    marker = out / "profile.json"
+    if marker.is_file():
+        saved = json.loads(marker.read_text()).get("name")
+        if saved != profile.name:
+            raise ParameterError(f"--out {out} holds a {saved!r} run; use another folder for a {profile.name!r} run")
+    out.mkdir(parents=True, exist_ok=True)
+    marker.write_text(json.dumps(profile.to_dict(), indent=1) + "\n")
+
