@@ -1,9 +1,9 @@
-# One-word commands. `make walk` and `make test` set everything up on a fresh machine first.
+# One-word commands. `make reproduce`, `make walk` and `make test` set everything up on a fresh machine first.
 VENV ?= .venv
 PY := $(VENV)/bin/python
 OUT ?= out
 
-.PHONY: setup walk test test-fast lint format window-map bench clean
+.PHONY: setup reproduce walk test test-fast lint format window-map bench clean
 
 setup: $(VENV)/.installed
 
@@ -16,6 +16,9 @@ $(VENV)/.installed: pyproject.toml
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test]'
 	touch $@
+
+reproduce: setup
+	$(VENV)/bin/drake-biped reproduce --quick --out $(OUT)/reproduce-quick
 
 walk: setup
 	$(VENV)/bin/drake-biped walk --out $(OUT)/walk

@@ -139,6 +139,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Profile, c
     verdicts.append(("Time step", "—", "chosen " + ("none" if ts["chosen_step_s"] is None
                                                       else f"{1e3 * ts['chosen_step_s']:g} ms"), BEYOND))
 
+    summary_figure(verdicts, f"drake-biped reproduce ({profile.name}): the paper's claims, measured",
+                   out / "report_summary.png")
     lines = [
         "# drake-biped: the paper reproduced, experiment by experiment",
         "",
@@ -153,6 +155,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Profile, c
     ]
     lines += [f"| {a} | {b} | {c} | **{d}** |" for a, b, c, d in verdicts]
     lines += [
+        "",
+        "![verdicts](report_summary.png)",
         "",
         "## The walk (`walk/`)",
         "",
@@ -275,6 +279,46 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Profile, c
         "",
     ]
     return "\n".join(lines)
+
+
+VERDICT_COLOURS = ((REPRODUCED, "#c8e6c9"), (PARTLY, "#ffe0b2"), (DIFFERS, "#ffe0b2"), (NOT_REPRODUCED, "#ffcdd2"),
+                   (BEYOND, "#e0e0e0"))
+
+
+def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: Path) -> None:
+    """The verdict table as a picture: one row per claim, the verdict cell coloured."""
+    import textwrap
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    widths = (34, 26, 44, 34)
+    cells = [["\n".join(textwrap.wrap(text.replace("**", ""), w)) or "—" for text, w in zip(row, widths)]
+             for row in verdicts]
+    heights = [max(c.count("\n") + 1 for c in row) for row in cells]
+    fig_h = 0.9 + 0.2 * (sum(heights) + len(heights))
+    fig, ax = plt.subplots(figsize=(13, fig_h))
+    ax.axis("off")
+    table = ax.table(cellText=cells, colLabels=["claim", "paper", "ours", "verdict"], loc="upper center",
+                     cellLoc="left", colWidths=[w / sum(widths) for w in widths])
+    table.auto_set_font_size(False)
+    table.set_fontsize(8)
+    total = sum(heights) + len(heights) + 1
+    for (r, c), cell in table.get_celld().items():
+        h = 1 if r == 0 else heights[r - 1] + 1
+        cell.set_height(h / total * 0.95)
+        if r == 0:
+            cell.set_facecolor("#eeeeee")
+        elif c == 3:
+            for key, colour in VERDICT_COLOURS:
+                if verdicts[r - 1][3].startswith(key):
+                    cell.set_facecolor(colour)
+                    break
+    ax.set_title(title, fontsize=10)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
 
 
 def _profile_text(p: Profile) -> str:

@@ -108,7 +108,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for row in table:  # every verdict row holds a measured number and a verdict
         ours = row.split(" | ")[2]
         assert re.search(r"\d", ours), row
-    for figure in ("walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
+    for figure in ("report_summary.png", "walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
                    "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
     html = (tmp_path / "report.html").read_text()
