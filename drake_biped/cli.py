@@ -440,7 +440,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     check_out(out, profile)
     hours = profile.expected_minutes / 60
     print(f"reproduce ({profile.name}): {len(Reproduction.STEPS)} experiments into {out}/, expected about "
-          + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.0f} h")
+          + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
           + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
     Reproduction(out, profile, args.workers, args.scheduler).run_all()
     print("\n".join(line for line in (out / "report.md").read_text().splitlines()[:40] if line.startswith("|")))
