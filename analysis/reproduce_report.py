@@ -144,8 +144,9 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Profile, c
     lines = [
         "# drake-biped: the paper reproduced, experiment by experiment",
         "",
-        f"Profile **{profile.name}** ({_profile_text(profile)}); {len(s)} experiments, {wall / 60:.1f} min of "
-        f"computing in all. drake-biped {code.get('drake_biped')} ({code.get('git_commit')}), Drake "
+        f"Profile **{profile.name}** ({_profile_text(profile)}); {len(s)} experiments, whose sessions in this "
+        f"folder took {wall / 60:.1f} min (work found already done in the folder, such as learning episodes "
+        f"resumed, is not counted). drake-biped {code.get('drake_biped')} ({code.get('git_commit')}), Drake "
         f"{code.get('drake')}. Paper: Takita, Azuma & Shibata, *Acquisition of Energy-Efficient Bipedal Walking "
         "Using CPG-Based Reinforcement Learning*. Each row links to its section; every number below is measured "
         "by this run, in the folder named in its section.",
