@@ -20,7 +20,9 @@ REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
 
 
 def _pct(x: float | None) -> str:
-    return "—" if x is None else f"{100 * x:+.1f} %"
+    if x is None:
+        return "—"
+    return "0.0 %" if abs(x) < 5e-4 else f"{100 * x:+.1f} %"
 
 
 def _num(x: float | None, digits: int = 3) -> str:
