@@ -63,7 +63,7 @@ def test_table_vii_compares_the_direction_of_each_change():
     summary = {"base_cpg": {"u_a": 1.6, "u_r": 4.6, "kappa": 2.6},
                "best": {"point": {"cpg.u_a": 2.0, "cpg.kappa": 2.0, "gait.torso_pitch_rad": -0.38}}}
     rows, changes, verdict = table_vii_rows(summary)
-    assert changes == "u_a +25.0 %, u_r +0.0 %, kappa -23.1 %"
+    assert changes == "u_a +25.0 %, u_r 0.0 %, kappa -23.1 %"  # no change prints without a sign
     assert "1 of 3 CPG parameters move as in Table VII" in verdict and "torso_pitch_rad = -0.38" in verdict
     assert rows[0] == "| u_a | 2 → 2.74 (+37.0 %) | 1.6 → 2 (+25.0 %) |"
 
