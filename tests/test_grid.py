@@ -142,3 +142,17 @@ def test_grid_refuses_bad_options(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["grid", "--spec", "x.yaml", "--points-per-axis", "2", "--out", str(tmp_path / "g")])
     assert "either --spec or --points-per-axis" in capsys.readouterr().err
+
+
+def test_shipped_specs_and_parameter_files_are_valid():
+    from pathlib import Path
+
+    repo = Path(__file__).resolve().parent.parent
+    sizes = {p.name: len(grid_points(load_spec(p))) for p in sorted((repo / "grids").glob("*.yaml"))}
+    assert sizes == {"around_default.yaml": 64, "slope_0.02.yaml": 36, "slope_2deg.yaml": 64, "tiny.yaml": 4}
+    for p in (repo / "grids").glob("*.yaml"):
+        for point in grid_points(load_spec(p)):
+            point_config(EpisodeConfig(), point)
+    for p in (repo / "params").glob("*.json"):  # the climbing gaits differ from the default by the grid's axes
+        config = EpisodeConfig.from_dict(json.loads(p.read_text()))
+        assert config.gait.torso_pitch_rad < EpisodeConfig().gait.torso_pitch_rad
