@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
 
+from analysis.series import moving_average  # noqa: E402
 from drake_biped.kinematics import leg_points  # noqa: E402
 from drake_biped.params import TABLE_I_LENGTHS_M  # noqa: E402
 
@@ -156,17 +157,6 @@ TABLE_V_PAPER = {"ASIMO": 1.60, "CPG without torque-free period": 0.58, "CPG wit
                  "human": 0.05}
 
 
-def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
-    """Trailing moving average over up to n samples, ignoring NaNs (NaN where a window has none)."""
-    out = np.full(x.shape, np.nan)
-    for i in range(len(x)):
-        w = x[max(0, i - n + 1) : i + 1]
-        w = w[np.isfinite(w)]
-        if w.size:
-            out[i] = w.mean()
-    return out
-
-
 def _learning_arrays(record: dict) -> dict[str, np.ndarray]:
     trials = record["trials"]
     n = min(len(t["episodes"]) for t in trials)
@@ -217,7 +207,7 @@ def _learning_figures(record: dict, out: Path) -> list[Path]:
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
     per_episode = np.nanmean(a["cmt"], axis=0)
     ax.plot(ep, per_episode, ".", color="0.7", ms=3, label="mean over trials (walks only)")
-    ax.plot(ep, _moving_average(per_episode, window), color="C3", label=f"{window}-episode moving average")
+    ax.plot(ep, moving_average(per_episode, window), color="C3", label=f"{window}-episode moving average")
     ev = record.get("evaluation") or {}
     if ev.get("no_window", {}).get("cost_of_transport"):
         ax.axhline(ev["no_window"]["cost_of_transport"], color="k", ls="--", lw=0.8, label="no torque-free period")
@@ -232,7 +222,7 @@ def _learning_figures(record: dict, out: Path) -> list[Path]:
 
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11.5, 3.8), sharey=True)
     for key, color, name in (("1", "C0", "t̄1 (start)"), ("2", "C1", "t̄2 (end)")):
-        ax.plot(ep, _moving_average(np.nanmean(a[f"t{key}"], axis=0), window), color=color, lw=0.8, alpha=0.5,
+        ax.plot(ep, moving_average(np.nanmean(a[f"t{key}"], axis=0), window), color=color, lw=0.8, alpha=0.5,
                 label=f"sampled t{key}, {window}-episode moving average")
         ax.plot(ep, np.nanmean(a[f"mean_t{key}"], axis=0), color=color, lw=2, label=f"policy mean {name}")
     ax.set_xlabel("episode")
@@ -341,7 +331,7 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
     """The torque-free period (the paper's Fig. 8 at 0.02 rad, Fig. 10 at 2.0 deg) and the walking distance
     (Fig. 9 / Fig. 11) over the episodes of online learning on the slope, 20-episode moving averages, one
     line per trial; with the starting policy's period and the two check episodes for reference."""
-    from drake_biped.slope import MOVING_AVERAGE, moving_average, period
+    from drake_biped.slope import MOVING_AVERAGE, period
 
     out = Path(out)
     slope = record["ground"]["slope_rad"]
@@ -355,7 +345,7 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
         ep = trial["episodes"]
         x = np.arange(1, len(ep) + 1)
         color = f"C{k % 10}"
-        ax.plot(x, moving_average([period(e["t1"], e["t2"]) for e in ep]), color=color,
+        ax.plot(x, moving_average([period(e["t1"], e["t2"]) for e in ep], MOVING_AVERAGE), color=color,
                 label=f"trial {trial['trial']}: sampled period, {MOVING_AVERAGE}-episode average")
         ax.plot(x, [period(e["mean_t1"], e["mean_t2"]) for e in ep], color=color, ls=":", lw=1,
                 label=f"trial {trial['trial']}: policy mean's period")
@@ -374,7 +364,7 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
         ep = trial["episodes"]
         x = np.arange(1, len(ep) + 1)
         ax.plot(x, [e["distance_m"] for e in ep], ".", color=f"C{k % 10}", ms=3, alpha=0.4)
-        ax.plot(x, moving_average([e["distance_m"] for e in ep]), color=f"C{k % 10}",
+        ax.plot(x, moving_average([e["distance_m"] for e in ep], MOVING_AVERAGE), color=f"C{k % 10}",
                 label=f"trial {trial['trial']}, {MOVING_AVERAGE}-episode average")
     checks = record["checks"]
     ax.axhline(checks["start_window"]["distance_m"], color="C3", ls="--", lw=0.8,

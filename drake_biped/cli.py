@@ -349,35 +349,9 @@ def cmd_push_margin(args: argparse.Namespace) -> int:
     return 0
 
 
-class _RunProgress:
-    """A progress bar and the run log OUT/run.json (`learning.SessionLog`: each session's count and wall
-    time) for a resumable run; called as progress(done, total, ...) by the run as it goes."""
-
-    def __init__(self, out: Path, args: argparse.Namespace, desc: str, unit: str):
-        from tqdm import tqdm
-
-        from drake_biped.learning import SessionLog
-
-        out.mkdir(parents=True, exist_ok=True)
-        self.log = SessionLog(out / "run.json", args.workers, args.scheduler)
-        self.bar = tqdm(total=0, desc=desc, unit=unit)
-        self.first: int | None = None
-
-    def __call__(self, done: int, total: int, *_) -> None:
-        if self.first is None:
-            self.first = done
-        self.log.update(done - self.first)
-        self.bar.total = total
-        self.bar.n = done
-        self.bar.refresh()
-
-    def close(self) -> None:
-        self.bar.close()
-        self.log.update(0 if self.first is None else self.bar.n - self.first, finished=True)
-
-
 def cmd_grid(args: argparse.Namespace) -> int:
     from drake_biped.grid import load_spec, run_grid, table_iv_axes
+    from drake_biped.learning import RunProgress
     from drake_biped.parallel import dask_client
 
     config = _episode_config(args)
@@ -386,12 +360,13 @@ def cmd_grid(args: argparse.Namespace) -> int:
         raise ParameterError("give either --spec or --points-per-axis, not both")
     axes = load_spec(Path(args.spec)) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
     out = Path(args.out)
-    progress = _RunProgress(out, args, "grid", "point")
+    progress = RunProgress(out, args.workers, args.scheduler, "grid", "point")
     try:
         with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
             record = run_grid(out, config, axes, client, progress)
     finally:
         progress.close()
+    progress.log.update(progress.new, finished=True)
     best = record["best"]
     cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
     print(f"{record['walked_the_distance']}/{record['points']} points walk {config.sim.distance_m:g} m; best "
@@ -401,6 +376,7 @@ def cmd_grid(args: argparse.Namespace) -> int:
 
 
 def cmd_slope(args: argparse.Namespace) -> int:
+    from drake_biped.learning import RunProgress
     from drake_biped.parallel import dask_client
     from drake_biped.slope import run_slope, slope_ground, start_from_learning, start_from_window
 
@@ -419,13 +395,14 @@ def cmd_slope(args: argparse.Namespace) -> int:
     else:
         state, source = start_from_window(*_chosen_window(args), args.variance)
     out = Path(args.out)
-    progress = _RunProgress(out, args, "slope learning", "episode")
+    progress = RunProgress(out, args.workers, args.scheduler, "slope learning", "episode")
     try:
         with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
             run_slope(out, config, ground, state, source, args.trials, args.episodes, config.seed,
                       client, progress)
     finally:
         progress.close()
+    progress.log.update(progress.new, finished=True)
     print((out / "report.md").read_text())
     print(f"wrote {out}/slope.json, report.md, fig8_period.png, fig9_distance.png")
     return 0
@@ -463,6 +440,12 @@ def _add_window_options(p: argparse.ArgumentParser) -> None:
 def _add_cluster_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
     p.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+
+
+def _add_resumable_run_options(p: argparse.ArgumentParser) -> None:
+    """The cluster options and --out of a command that resumes when rerun."""
+    _add_cluster_options(p)
+    p.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -517,8 +500,7 @@ def build_parser() -> argparse.ArgumentParser:
                        metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
     learn.add_argument("--variance", type=_number("positive"), default=0.04,
                        help="the policy's variance per time (s^2); default 0.04 as in the paper")
-    _add_cluster_options(learn)
-    learn.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    _add_resumable_run_options(learn)
     learn.set_defaults(func=cmd_learn)
 
     land = sub.add_parser("landscape", help="the expected reward GARB climbs, from a window map, for given variances")
@@ -540,8 +522,7 @@ def build_parser() -> argparse.ArgumentParser:
     stab.add_argument("--push", type=_number("positive"), default=20.0, help="push force (N); default 20")
     stab.add_argument("--spread", type=_number("nonnegative"), default=0.15,
                       help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
-    _add_cluster_options(stab)
-    stab.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    _add_resumable_run_options(stab)
     stab.set_defaults(func=cmd_stability)
 
     pm = sub.add_parser("push-margin", help="the largest forward and backward push the gait survives, "
@@ -561,8 +542,7 @@ def build_parser() -> argparse.ArgumentParser:
                       "initial hip angle (0-15.2 deg) and speed (0-0.35 m/s); default 2 (128 points)")
     grid.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
                       "{values: [...]}}; see grids/")
-    _add_cluster_options(grid)
-    grid.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    _add_resumable_run_options(grid)
     grid.set_defaults(func=cmd_grid)
 
     sl = sub.add_parser("slope", help="slope adaptation: does the learned torque-free period climb, does none, "
@@ -574,15 +554,13 @@ def build_parser() -> argparse.ArgumentParser:
                     "(--policy carries its own)")
     sl.add_argument("--episodes", type=_count, default=100, help="learning episodes per trial (default 100)")
     sl.add_argument("--trials", type=_count, default=2, help="independent learning trials (default 2)")
-    _add_cluster_options(sl)
-    sl.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    _add_resumable_run_options(sl)
     sl.set_defaults(func=cmd_slope)
 
     rep = sub.add_parser("reproduce", help="every experiment of the paper and one report beside its numbers "
                          "(--quick: small settings, minutes)")
     rep.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
-    _add_cluster_options(rep)
-    rep.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    _add_resumable_run_options(rep)
     rep.set_defaults(func=cmd_reproduce)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")

@@ -306,6 +306,44 @@ class SessionLog:
                 "episodes_per_min": 60.0 * episodes_all / wall_all if episodes_all and wall_all > 0 else None})
 
 
+class RunProgress:
+    """A progress bar (when `bar` is set) and the run log OUT/run.json (`SessionLog`) of a resumable run;
+    called as progress(done, total, latest_mean_reward=None) by the run as it goes."""
+
+    def __init__(self, out: Path, workers: int | None, scheduler: str | None, desc: str, unit: str,
+                 bar: bool = True):
+        out.mkdir(parents=True, exist_ok=True)
+        self.log = SessionLog(out / "run.json", workers, scheduler)
+        self.bar = None
+        if bar:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=0, desc=desc, unit=unit)
+        self.first: int | None = None
+        self.done = 0
+
+    def __call__(self, done: int, total: int, latest: float | None = None) -> None:
+        if self.first is None:
+            self.first = done
+        self.done = done
+        self.log.update(done - self.first)
+        if self.bar is not None:
+            self.bar.total = total
+            self.bar.n = done
+            if latest is not None:
+                self.bar.set_postfix_str(f"latest mean reward {latest:.3f}", refresh=False)
+            self.bar.refresh()
+
+    @property
+    def new(self) -> int:
+        """What this session computed."""
+        return 0 if self.first is None else self.done - self.first
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
 def learn(out: Path, settings: dict[str, Any], workers: int | None = None, scheduler: str | None = None,
           progress: bool = True) -> dict[str, Any]:
     """Run or resume the learning, evaluate, write learning.json, run.json, the figures and Table V."""
@@ -313,34 +351,16 @@ def learn(out: Path, settings: dict[str, Any], workers: int | None = None, sched
     from drake_biped.parallel import dask_client
 
     versions()  # the code version this process runs, recorded now (it is cached), not at the run's end
-    out.mkdir(parents=True, exist_ok=True)
-    log = SessionLog(out / "run.json", workers, scheduler)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=settings["trials"] * settings["episodes"], desc="learning", unit="episode")
-    start: list[int] = []
-
-    def report(done: int, total: int, latest: float | None) -> None:
-        if not start:
-            start.append(done)
-        log.update(done - start[0])
-        if bar is not None:
-            bar.n = done
-            bar.set_postfix_str("" if latest is None else f"latest mean reward {latest:.3f}", refresh=False)
-            bar.refresh()
-
+    report = RunProgress(out, workers, scheduler, "learning", "episode", bar=progress)
     try:
         with dask_client(workers=workers, scheduler=scheduler) as client:
             trials, new = run_learning(out, settings, client, report)
-            log.update(new, force=True)
+            report.log.update(new, force=True)
             evaluation = evaluate(settings, trials, client)
     finally:
-        if bar is not None:
-            bar.close()
+        report.close()
     record = learning_record(settings, trials, evaluation)
     write_atomic(out / "learning.json", record)
-    log.update(new, learning=False, finished=True)
+    report.log.update(new, learning=False, finished=True)
     learning_figures(record, out)
     return record

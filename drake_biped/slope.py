@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from analysis.series import moving_average
 from drake_biped.garb import GarbLearner
 from drake_biped.learning import make_settings, run_learning, trial_seed, window_of, write_atomic
 from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow
@@ -91,15 +92,7 @@ def period(t1: float, t2: float) -> float:
     return float(max(0.0, max(0.0, t2) - max(0.0, t1)))
 
 
-def moving_average(x: np.ndarray, n: int = MOVING_AVERAGE) -> np.ndarray:
-    """Trailing average over the last min(n, i + 1) values."""
-    c = np.cumsum(np.insert(np.asarray(x, dtype=float), 0, 0.0))
-    i = np.arange(1, len(x) + 1)
-    lo = np.maximum(0, i - n)
-    return (c[i] - c[lo]) / (i - lo)
-
-
-def trial_summary(episodes: list[dict[str, Any]], distance_m: float, start_period_s: float) -> dict[str, Any]:
+def trial_summary(episodes: list[dict[str, Any]], distance_m: float) -> dict[str, Any]:
     """How one trial's sampled periods and distances developed: first and last 20-episode averages, the
     share of climbing episodes among the last 20, and the first episode whose 20-episode average distance
     is the full distance (None if never)."""
@@ -108,13 +101,12 @@ def trial_summary(episodes: list[dict[str, Any]], distance_m: float, start_perio
     mean_p = np.array([period(e["mean_t1"], e["mean_t2"]) for e in episodes])
     up = np.array([(not e["fell"]) and e["distance_m"] >= distance_m - 1e-6 for e in episodes])
     n = min(MOVING_AVERAGE, len(episodes))
-    ma = moving_average(d)
+    ma = moving_average(d, MOVING_AVERAGE)
     reached = np.flatnonzero(ma >= distance_m - 1e-6)
     return {
         "episodes": len(episodes),
         "period_first_s": float(p[:n].mean()),
         "period_last_s": float(p[-n:].mean()),
-        "mean_period_start_s": start_period_s,
         "mean_period_end_s": float(mean_p[-1]),
         "distance_first_m": float(d[:n].mean()),
         "distance_last_m": float(d[-n:].mean()),
@@ -146,7 +138,7 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
     trial_rows = []
     for t in runs:
         row = {"trial": t.index, "learner_seed": trial_seed(seed, t.index), "final_mean": t.learner.mean.tolist(),
-               **trial_summary(t.episodes, config.sim.distance_m, start_period),
+               **trial_summary(t.episodes, config.sim.distance_m),
                "final_policy": _summary(finals[f"final_trial_{t.index}"])}
         trial_rows.append(row)
     record = {

@@ -56,7 +56,7 @@ def test_period_and_moving_average():
 def test_trial_summary_finds_when_the_average_reaches_the_distance():
     episodes = [{"t1": 0.1, "t2": 0.5, "mean_t1": 0.1, "mean_t2": 0.5, "distance_m": 2.0, "fell": True}] * 5
     episodes += [{"t1": 0.3, "t2": 0.2, "mean_t1": 0.3, "mean_t2": 0.25, "distance_m": 10.0, "fell": False}] * 25
-    s = trial_summary(episodes, 10.0, 0.4)
+    s = trial_summary(episodes, 10.0)
     assert s["first_full_average_episode"] == 25  # the first 20-episode window without the 5 falls
     assert s["period_first_s"] == pytest.approx((5 * 0.4 + 15 * 0.0) / 20)
     assert (s["period_last_s"], s["mean_period_end_s"], s["climb_share_last"]) == (0.0, 0.0, 1.0)
@@ -124,3 +124,7 @@ def test_slope_story_on_a_short_setting(tmp_path):
     for name in ("fig8_period.png", "fig9_distance.png", "report.md"):
         assert (tmp_path / "climbing" / name).stat().st_size > 0
     assert "| the learned torque-free period fails to climb |" in (tmp_path / "climbing" / "report.md").read_text()
+
+
+def test_moving_average_skips_missing_values():
+    np.testing.assert_allclose(moving_average([np.nan, 1.0, np.nan, 3.0], 2), [np.nan, 1.0, 1.0, 3.0])

@@ -1,0 +1,19 @@
+"""Small helpers on per-episode series (pure numpy)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def moving_average(x, n: int = 20) -> np.ndarray:
+    """Trailing moving average over the last min(n, i + 1) values, ignoring NaNs (NaN where a window holds
+    none). n = 20 is the paper's window in Figs. 8-11."""
+    x = np.asarray(x, dtype=float)
+    ok = np.isfinite(x)
+    total = np.cumsum(np.insert(np.where(ok, x, 0.0), 0, 0.0))
+    count = np.cumsum(np.insert(ok, 0, False))
+    i = np.arange(1, len(x) + 1)
+    lo = np.maximum(0, i - n)
+    n_ok = count[i] - count[lo]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n_ok > 0, (total[i] - total[lo]) / n_ok, np.nan)
