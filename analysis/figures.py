@@ -13,9 +13,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
 
-from analysis.series import moving_average  # noqa: E402
+from drake_biped.analysis.series import moving_average, period  # noqa: E402
 from drake_biped.kinematics import leg_points  # noqa: E402
-from drake_biped.params import TABLE_I_LENGTHS_M  # noqa: E402
+from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
+from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_V, TABLE_V_REDUCTION  # noqa: E402
 
 JOINTS = ("left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle")
 COLORS = {"left": "#2f6fbf", "right": "#d9661f"}
@@ -153,8 +154,7 @@ def window_map_figure(rows: list[dict], baseline_cmt: float | None, path: str | 
 
 
 # Table V of the paper (C_mt) and our measured rows.
-TABLE_V_PAPER = {"ASIMO": 1.60, "CPG without torque-free period": 0.58, "CPG with torque-free period": 0.29,
-                 "human": 0.05}
+TABLE_V_PAPER = TABLE_V
 
 
 def _learning_arrays(record: dict) -> dict[str, np.ndarray]:
@@ -270,7 +270,7 @@ def table_v(record: dict) -> str:
         f"{TABLE_V_PAPER['CPG with torque-free period']:.2f} | {TABLE_V_PAPER['human']:.2f} |",
         f"| ours (measured) | — | {fmt(base)} | {ours_learned} | — |",
         "",
-        f"Reduction: paper {100 * (1 - 0.29 / 0.58):.0f} %, ours "
+        f"Reduction: paper {100 * TABLE_V_REDUCTION:.0f} %, ours "
         + ("—" if reduction is None else f"{100 * reduction:.1f} %")
         + f". Ours: one {record['settings']['config']['sim']['distance_m']:g} m walk without a window, and one with "
         "each trial's final policy mean (t̄1, t̄2):",
@@ -331,8 +331,6 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
     """The torque-free period (the paper's Fig. 8 at 0.02 rad, Fig. 10 at 2.0 deg) and the walking distance
     (Fig. 9 / Fig. 11) over the episodes of online learning on the slope, 20-episode moving averages, one
     line per trial; with the starting policy's period and the two check episodes for reference."""
-    from drake_biped.slope import MOVING_AVERAGE, period
-
     out = Path(out)
     slope = record["ground"]["slope_rad"]
     level = record["ground"]["level_length_m"]
@@ -380,3 +378,30 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
     fig.savefig(paths[1], dpi=120)
     plt.close(fig)
     return paths
+
+
+def landscape_figure(record: dict, path) -> None:
+    """The expected reward GARB climbs (`analysis.landscape`) over the policy mean, one panel per variance."""
+    cells = record["variances"]
+    base = record["no_window_reward"]
+    fig, axes = plt.subplots(1, len(cells), figsize=(4.6 * len(cells), 4.2), squeeze=False)
+    t1, t2 = np.array(record["t1"]), np.array(record["t2"])
+    for ax, cell in zip(axes[0], cells):
+        gain = 100.0 * (np.array(cell["expected_reward"]) / base - 1.0)
+        lim = max(1.0, float(np.nanmax(np.abs(gain))))
+        im = ax.pcolormesh(t1, t2, gain, cmap="RdBu", vmin=-lim, vmax=lim, shading="nearest")
+        ax.contour(t1, t2, gain, levels=[0.0], colors="k", linewidths=0.8)
+        ax.plot(*cell["best_mean"], "k*", ms=12, label=f"max J: {100 * cell['best_gain']:+.0f} %")
+        for s in cell["starts"]:
+            ax.plot(*s["mean"], "ko", mfc="none", ms=8, label=f"start {tuple(s['mean'])}: {100 * s['gain']:+.0f} %")
+        ax.plot([0, min(t1[-1], t2[-1])], [0, min(t1[-1], t2[-1])], "k:", lw=0.8)
+        ax.set_title(f"σ² = {cell['variance']:g} s²", fontsize=10)
+        ax.set_xlabel("policy mean t̄1 [s]")
+        ax.set_ylabel("policy mean t̄2 [s]")
+        ax.legend(fontsize=7, loc="upper left")
+        fig.colorbar(im, ax=ax, label="expected reward vs no window [%]")
+    fig.suptitle("What GARB climbs: expected reward of N(T̄, σ²I) over measured windows (below the dotted "
+                 "line: no window)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

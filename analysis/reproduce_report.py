@@ -13,7 +13,8 @@ import re
 from pathlib import Path
 from typing import Any
 
-from drake_biped.reproduce import LEVEL_WINDOW, PAPER_REDUCTION, SLOPE_START, TABLE_VII_PAPER, Profile
+from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
+from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
 
 REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
     "reproduced", "partly reproduced", "not reproduced", "differs", "beyond the paper")
@@ -104,7 +105,8 @@ def table_vii_rows(summary: dict[str, Any]) -> tuple[list[str], str, str]:
     return rows, ", ".join(changes), f"{DIFFERS}: {same} of 3 CPG parameters move as in Table VII{note}"
 
 
-def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Profile, code: dict[str, Any]) -> str:
+def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any]) -> str:
+    LEVEL_WINDOW = tuple(s["push_margin"]["settings"]["window"])  # the window compared with none
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
     verdicts: list[tuple[str, str, str, str]] = []  # (what, paper, ours, verdict)
 
@@ -245,7 +247,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Profile, c
         "",
     ]
     for name, figs in (("slope", "Figs. 8–9"), ("slope2deg", "Figs. 10–11")):
-        t1, t2 = SLOPE_START[name]
+        t1, t2 = s[name]["settings"]["start"]
         lines += [
             f"### The slope story, {figs} (`{name}/`)",
             "",
@@ -324,7 +326,7 @@ def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: 
     plt.close(fig)
 
 
-def _profile_text(p: Profile) -> str:
+def _profile_text(p: Any) -> str:
     return (f"learning {p.learn[0]}×{p.learn[1]} and {p.learn_variant[0]}×{p.learn_variant[1]} episodes, "
             f"{p.stability_trials} trials per stability cell, slope learning {p.slope[0]}×{p.slope[1]}, "
             f"grid {p.grid_points} points per Table IV range")
@@ -341,7 +343,7 @@ def report_html(markdown_text: str) -> str:
             "font-size:90%}img{max-width:100%}</style></head><body>" + body + "</body></html>\n")
 
 
-def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Profile,
+def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Any,
                  code: dict[str, Any]) -> list[Path]:
     text = report_markdown(out, summaries, profile, code)
     paths = [out / "report.md", out / "report.html"]

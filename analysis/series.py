@@ -1,4 +1,4 @@
-"""Small helpers on per-episode series (pure numpy)."""
+"""Small helpers on per-episode series (pure numpy): moving averages, torque-free period lengths."""
 
 from __future__ import annotations
 
@@ -17,3 +17,9 @@ def moving_average(x, n: int = 20) -> np.ndarray:
     n_ok = count[i] - count[lo]
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(n_ok > 0, (total[i] - total[lo]) / n_ok, np.nan)
+
+
+def period(t1: float, t2: float) -> float:
+    """Length of the torque-free period a (t1, t2) sample or mean gives: t2 - t1 with times below 0 acting
+    as 0, and 0 when t2 <= t1."""
+    return float(max(0.0, max(0.0, t2) - max(0.0, t1)))

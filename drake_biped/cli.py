@@ -1,14 +1,17 @@
 """Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin | grid | slope | reproduce`.
 
-Every numeric option is validated here, at the boundary, with a message that names the option and value.
+Parsing only: each command turns its options into its experiment's settings and calls the experiment's
+`run(settings, out, client)` (drake_biped.experiments), which writes every file. Every numeric option is
+validated here, at the boundary, with a message that names the option and value; every parallel command
+takes the same `--workers N | --scheduler ADDR`.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 from drake_biped.params import (
@@ -58,7 +61,8 @@ _count = _integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--params", type=Path, help="JSON file with EpisodeConfig fields (cpg, gait, initial, ...)")
+    p.add_argument("--params", help="a shipped gait by name (climbing, climbing_2deg) or a JSON file of "
+                   "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
     p.add_argument("--distance", type=_number("positive"), help="walk this far (m); default 10")
     p.add_argument("--max-time", type=_number("positive"), help="simulated time limit (s); default 60")
     p.add_argument("--time-step", type=_number("positive"), help="plant and control time step (s); default 0.001")
@@ -69,14 +73,9 @@ def _add_episode_options(p: argparse.ArgumentParser) -> None:
 
 
 def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
-    config = EpisodeConfig()
-    if args.params is not None:
-        from drake_biped.learning import read_json
+    from drake_biped.resources import load_gait
 
-        data = read_json(args.params, "--params")
-        if isinstance(data, dict) and "config" in data:  # a result.json: reuse the config that made it
-            data = data["config"]
-        config = EpisodeConfig.from_dict(data)
+    config = EpisodeConfig() if args.params is None else load_gait(args.params)
     sim = config.sim
     if args.distance is not None or args.max_time is not None or args.time_step is not None:
         sim_d = sim.to_dict()
@@ -101,22 +100,22 @@ def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     return config.replace(sim=sim, ground=ground, seed=seed)
 
 
-def _progress_bar(total_m: float, desc: str):
-    from tqdm import tqdm
+@contextmanager
+def _client(args: argparse.Namespace):
+    """The Dask client of the cluster options: --scheduler ADDR, or a LocalCluster of --workers N."""
+    from drake_biped.experiments.executor import dask_client
 
-    bar = tqdm(total=round(total_m, 2), desc=desc, unit="m", bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} m [{elapsed}<{remaining}{postfix}]")
+    _check_cluster_options(args)
+    with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+        yield client
 
-    def update(t: float, d: float) -> None:
-        d = min(max(d, 0.0), total_m)
-        bar.n = round(d, 2)
-        bar.set_postfix_str(f"t={t:.1f}s", refresh=False)
-        bar.refresh()
 
-    return bar, update
+def _print(lines) -> None:
+    print("\n".join(lines))
 
 
 def cmd_walk(args: argparse.Namespace) -> int:
-    from drake_biped.outputs import write_walk
+    from drake_biped.experiments import walk
 
     config = _episode_config(args)
     if (args.t1 is None) != (args.t2 is None):
@@ -126,62 +125,49 @@ def cmd_walk(args: argparse.Namespace) -> int:
     if args.push is not None:
         config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
     out = Path(args.out)
-    bar, update = _progress_bar(config.sim.distance_m, "walk")
-    try:
-        result = write_walk(config, out, animation=not args.no_animation, save_trajectory=args.save_trajectory,
-                            progress=update)
-    finally:
-        bar.close()
-    _print_summary(result)
+    result = walk.run(walk.WalkSettings(config, animation=not args.no_animation,
+                                        save_trajectory=args.save_trajectory), out)
+    _print(walk.summary_lines(result))
     print(f"wrote {out}/")
     return 0
 
 
-def _print_summary(result) -> None:
-    status = f"FELL ({result.fall_reason})" if result.fell else f"ended: {result.termination}"
-    cmt = "n/a" if result.cost_of_transport is None else f"{result.cost_of_transport:.3f}"
-    cmt_kg = "n/a" if result.cost_of_transport_per_kg is None else f"{result.cost_of_transport_per_kg:.3f}"
-    period = "n/a" if result.step_period_s is None else f"{result.step_period_s:.3f} s"
-    length = "n/a" if result.step_length_m is None else f"{result.step_length_m:.3f} m"
-    print(
-        f"{status}: {result.distance_m:.2f} m in {result.duration_s:.2f} s ({result.mean_speed_mps:.3f} m/s), "
-        f"{len(result.steps)} steps, step {period} / {length}\n"
-        f"positive work {result.total_positive_work_j:.1f} J, C_mt {cmt} (E+/(m g d)), "
-        f"{cmt_kg} J/(kg m) (paper's eq. 1)\n"
-        f"wall {result.wall_time_s:.1f} s, real-time factor {result.real_time_factor:.2f}"
-    )
-
-
 def cmd_window_map(args: argparse.Namespace) -> int:
-    from drake_biped.window_map import run_window_map
+    from drake_biped.experiments import window_map
 
-    config = _episode_config(args)
-    run_window_map(config, Path(args.out), t1_step=args.step, t2_step=args.step, workers=args.workers,
-                   t1_max=args.t1_max, t2_max=args.t2_max)
+    settings = window_map.WindowMapSettings(_episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
+                                            t1_step_s=args.step, t2_step_s=args.step)
+    with _client(args) as client:
+        record = window_map.run(settings, Path(args.out), client)
+    _print(window_map.summary_lines(record))
     return 0
 
 
 def cmd_gait_search(args: argparse.Namespace) -> int:
-    from drake_biped.gait_search import run_search
+    from drake_biped.experiments import gait_search
 
     config = _episode_config(args)
-    result = run_search(config, Path(args.out), generations=args.generations, offspring=args.offspring,
-                        sigma=args.sigma, seed=config.seed, distance_m=config.sim.distance_m
-                        if args.distance is not None else 6.0, workers=args.workers)
+    settings = gait_search.GaitSearchSettings(
+        config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
+        distance_m=config.sim.distance_m if args.distance is not None else 6.0)
+    with _client(args) as client:
+        result = gait_search.run(settings, Path(args.out), client)
     print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
     return 0
 
 
 def cmd_time_step_study(args: argparse.Namespace) -> int:
-    from drake_biped.time_step import replot, run_study
+    from drake_biped.experiments import time_step
 
     out = Path(args.out)
     if args.replot:
         if not (out / "time_step_study.json").is_file():
             raise ParameterError(f"--replot: no time_step_study.json in {out}")
-        rec = replot(out)
+        rec = time_step.replot(out)
     else:
-        rec = run_study(out, args.steps, args.reference, args.distance, args.workers, args.scheduler)
+        settings = time_step.TimeStepSettings(tuple(args.steps), args.reference, args.distance)
+        with _client(args) as client:
+            rec = time_step.run(settings, out, client)
     print((out / "time_step_study.md").read_text())
     chosen = rec["chosen_step_s"]
     print(f"chosen step: {chosen * 1e3:g} ms" if chosen else "no step passes", f"; wrote {out}/")
@@ -189,33 +175,23 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
 
 
 def cmd_learn(args: argparse.Namespace) -> int:
-    from drake_biped.learning import learn, make_settings
+    from drake_biped.experiments import learning
 
     config = _episode_config(args)
-    _check_cluster_options(args)
-    settings = make_settings(config, args.trials, args.episodes, args.seed if args.seed is not None else 0,
-                             mean=tuple(args.initial_mean), variance=args.variance)
+    settings = learning.LearningSettings(config, args.trials, args.episodes,
+                                         args.seed if args.seed is not None else 0,
+                                         mean=tuple(args.initial_mean), variance=args.variance)
+    record_settings = settings.record()  # validated before a cluster starts
     out = Path(args.out)
-    record = learn(out, settings, workers=args.workers, scheduler=args.scheduler)
-    ev = record["evaluation"]
-    print((out / "table_v.md").read_text())
-    base = ev["no_window"]["cost_of_transport"]
-    if ev.get("reduction") is not None:
-        print(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
-              f"{ev['learned_mean_cost_of_transport']:.3f}: {100 * ev['reduction']:.1f} % lower")
-    run = json.loads((out / "run.json").read_text())
-    this = run["sessions"][-1]
-    if this["episodes_per_min"]:
-        print(f"{this['episodes']} episodes in {this['learning_wall_s']:.0f} s "
-              f"({this['episodes_per_min']:.1f} episodes/min); the whole run so far: {run['episodes']} episodes, "
-              f"{run['learning_wall_s'] / 60:.1f} min of learning over {len(run['sessions'])} session(s)")
-    print(f"wrote {out}/learning.json, fig4_reward.png, fig5_cmt.png, fig6_times.png, table_v.md")
+    with _client(args) as client:
+        record = learning.run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler)
+    _print(learning.summary_lines(record, out))
     return 0
 
 
 def cmd_figures(args: argparse.Namespace) -> int:
-    from analysis.figures import learning_figures
-    from drake_biped.learning import read_json
+    from drake_biped.analysis.figures import learning_figures
+    from drake_biped.records import read_json
 
     out = Path(args.dir)
     for p in learning_figures(read_json(out / "learning.json", "figures: learning record"), out):
@@ -224,40 +200,22 @@ def cmd_figures(args: argparse.Namespace) -> int:
 
 
 def cmd_landscape(args: argparse.Namespace) -> int:
-    from analysis.policy_landscape import WindowRewards, landscape, landscape_figure
-    from drake_biped.learning import write_atomic
-    from drake_biped.versions import versions
+    from drake_biped.experiments import landscape
 
-    source = Path(args.window_map)
-    path = source / "window_map.json" if source.is_dir() else source
-    if not path.is_file():
-        raise ParameterError(f"landscape: no window map at {source} (run drake-biped window-map first)")
-    try:
-        wmap = json.loads(path.read_text())
-        rewards = WindowRewards.from_window_map(wmap)
-    except (json.JSONDecodeError, KeyError, TypeError) as exc:
-        raise ParameterError(f"landscape: {path} is not a window map ({exc})") from None
-    starts = [tuple(args.start)] if args.start else [(0.5, 0.5)]
-    record = landscape(rewards, args.variance, samples=args.samples, seed=args.seed, starts=starts)
-    record.update(window_map=str(path), samples=args.samples, seed=args.seed, versions=versions())
-    out = Path(args.out) if args.out else path.parent
-    out.mkdir(parents=True, exist_ok=True)
-    write_atomic(out / "landscape.json", record)
-    landscape_figure(record, out / "landscape.png")
-    base = record["no_window_reward"]
-    print(f"no window: reward {base:.3f}")
-    for cell in record["variances"]:
-        s = cell["starts"][0]
-        print(f"variance {cell['variance']:g}: best policy mean ({cell['best_mean'][0]:.3f}, {cell['best_mean'][1]:.3f}) "
-              f"expected reward {100 * cell['best_gain']:+.1f} % vs no window; at the start {tuple(s['mean'])} "
-              f"{100 * s['gain']:+.1f} %")
+    settings = landscape.LandscapeSettings(args.window_map, tuple(args.variance),
+                                           (tuple(args.start),) if args.start else ((0.5, 0.5),),
+                                           samples=args.samples, seed=args.seed)
+    record = landscape.run(settings, Path(args.out) if args.out else None)
+    _print(landscape.summary_lines(record))
+    out = Path(args.out) if args.out else settings.path().parent
     print(f"wrote {out}/landscape.json, landscape.png")
     return 0
 
 
 def _policy_window(path: Path) -> tuple[float, float]:
     """The learned torque-free period of a learning.json (`learning.best_learned_trial`)."""
-    from drake_biped.learning import best_learned_trial, read_json
+    from drake_biped.experiments.learning import best_learned_trial
+    from drake_biped.records import read_json
 
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
     return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
@@ -279,7 +237,7 @@ def _chosen_window(args: argparse.Namespace) -> tuple[float, float]:
 
 
 def _check_cluster_options(args: argparse.Namespace) -> None:
-    from drake_biped.parallel import check_scheduler_address
+    from drake_biped.experiments.executor import check_scheduler_address
 
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
@@ -288,138 +246,89 @@ def _check_cluster_options(args: argparse.Namespace) -> None:
 
 
 def cmd_stability(args: argparse.Namespace) -> int:
-    from analysis.stability_report import write_stability_outputs
-    from drake_biped.learning import write_atomic
-    from drake_biped.parallel import dask_client
-    from drake_biped.stability import StabilitySettings, run_stability
+    from drake_biped.experiments import stability
 
     config = _episode_config(args)
-    window = _chosen_window(args)
-    _check_cluster_options(args)
-    settings = StabilitySettings(window=window, trials=args.trials, push_force_n=args.push,
-                                 spread=args.spread, seed=config.seed)
+    settings = stability.StabilitySettings(window=_chosen_window(args), trials=args.trials,
+                                           push_force_n=args.push, spread=args.spread, seed=config.seed)
     out = Path(args.out)
-    from tqdm import tqdm
-
-    bar = tqdm(total=6 * settings.trials, desc="stability", unit="episode")
-
-    def progress(done: int, total: int) -> None:
-        bar.n = done
-        bar.refresh()
-
-    try:
-        with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
-            record = run_stability(out, config, settings, client, progress)
-    finally:
-        bar.close()  # (the finite-difference Jacobian's 102 episodes follow the cells, without a bar)
-    write_atomic(out / "stability.json", record)
-    write_stability_outputs(record, out)
+    with _client(args) as client:
+        stability.run(settings, out, client, config=config)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
     print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
     return 0
 
 
 def cmd_push_margin(args: argparse.Namespace) -> int:
-    from drake_biped.learning import write_atomic
-    from drake_biped.parallel import dask_client
-    from drake_biped.stability import push_margin
-    from drake_biped.versions import versions
+    from drake_biped.experiments import push_margin
 
-    config = _episode_config(args)
-    window = _chosen_window(args)
-    _check_cluster_options(args)
-    code = versions()
-    with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
-        record = push_margin(config, window, client, max_force_n=args.max_force, tolerance_n=args.tolerance,
-                             progress=lambda n: print(f"round {n}", file=sys.stderr))
-    record.update(config=config.to_dict(), versions=code)
+    settings = push_margin.PushMarginSettings(_episode_config(args), _chosen_window(args),
+                                              max_force_n=args.max_force, tolerance_n=args.tolerance)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    write_atomic(out / "push_margin.json", record)
-    lines = ["| | forward push survived (N) | backward push survived (N) |", "|---|---|---|"]
-    for condition, name in (("without", "without torque-free period"),
-                            ("with", f"with torque-free period {window[0]:.3f}-{window[1]:.3f} s")):
-        m = record["margins"][condition]
-        lines.append(f"| {name} | {m['forward']['survived_n']:.1f} | {m['backward']['survived_n']:.1f} |")
-    text = "\n".join(lines) + (f"\n\nPush for {record['push_duration_s']:g} s from {record['push_start_s']:g} s; "
-                               f"bisection to {args.tolerance:g} N, up to {args.max_force:g} N.\n")
-    (out / "push_margin.md").write_text(text)
-    print(text)
+    with _client(args) as client:
+        push_margin.run(settings, out, client)
+    print((out / "push_margin.md").read_text())
     print(f"wrote {out}/push_margin.json, push_margin.md")
     return 0
 
 
 def cmd_grid(args: argparse.Namespace) -> int:
-    from drake_biped.grid import load_spec, run_grid, table_iv_axes
-    from drake_biped.learning import RunProgress
-    from drake_biped.parallel import dask_client
+    from drake_biped.experiments import grid
 
     config = _episode_config(args)
-    _check_cluster_options(args)
     if args.spec is not None and args.points_per_axis is not None:
         raise ParameterError("give either --spec or --points-per-axis, not both")
-    axes = load_spec(Path(args.spec)) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
+    axes = grid.load_spec(args.spec) if args.spec is not None else grid.table_iv_axes(args.points_per_axis or 2)
     out = Path(args.out)
-    progress = RunProgress(out, args.workers, args.scheduler, "grid", "point")
-    try:
-        with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
-            record = run_grid(out, config, axes, client, progress)
-    finally:
-        progress.close()
-    progress.log.update(progress.new, finished=True)
-    best = record["best"]
-    cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
-    print(f"{record['walked_the_distance']}/{record['points']} points walk {config.sim.distance_m:g} m; best "
-          f"{', '.join(f'{k}={v:.4g}' for k, v in best['point'].items())}: {best['distance_m']:.2f} m, C_mt {cmt}")
-    print(f"wrote {out}/grid.csv, grid.json, grid_slices.png, best_params.json (use --params)")
+    with _client(args) as client:
+        record = grid.run(grid.GridSettings(config, tuple(axes)), out, client, workers=args.workers,
+                          scheduler=args.scheduler)
+    _print(grid.summary_lines(record, out))
     return 0
 
 
 def cmd_slope(args: argparse.Namespace) -> int:
-    from drake_biped.learning import RunProgress
-    from drake_biped.parallel import dask_client
-    from drake_biped.slope import run_slope, slope_ground, start_from_learning, start_from_window
+    from drake_biped.experiments import slope
 
     if args.slope is None:
         raise ParameterError("--slope is required (rad, > 0: the ascending slope after the level part)")
     level = args.level_length if args.level_length is not None else 2.0
-    args.level_length = None  # the slope ground is built below, not by the episode options
-    slope, args.slope = args.slope, None
+    args.level_length = None  # the slope ground is built by the slope settings, not by the episode options
+    slope_rad, args.slope = args.slope, None
     config = _episode_config(args)
-    ground = slope_ground(slope, level, config.ground.friction)
-    _check_cluster_options(args)
+    slope.slope_ground(slope_rad, level, config.ground.friction)  # refuse a bad slope before anything runs
     if args.policy is not None:
         if args.t1 is not None or args.t2 is not None:
             raise ParameterError("give either --policy or --t1/--t2, not both")
-        state, source = start_from_learning(Path(args.policy))
+        settings = slope.SlopeSettings(config, slope_rad, level, policy=str(args.policy), trials=args.trials,
+                                       episodes=args.episodes, seed=config.seed)
     else:
-        state, source = start_from_window(*_chosen_window(args), args.variance)
+        settings = slope.SlopeSettings(config, slope_rad, level, window=_chosen_window(args),
+                                       variance=args.variance, trials=args.trials, episodes=args.episodes,
+                                       seed=config.seed)
+    settings.start()  # a --policy that cannot be read is refused before a cluster starts
     out = Path(args.out)
-    progress = RunProgress(out, args.workers, args.scheduler, "slope learning", "episode")
-    try:
-        with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
-            run_slope(out, config, ground, state, source, args.trials, args.episodes, config.seed,
-                      client, progress)
-    finally:
-        progress.close()
-    progress.log.update(progress.new, finished=True)
+    with _client(args) as client:
+        slope.run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
     print((out / "report.md").read_text())
     print(f"wrote {out}/slope.json, report.md, fig8_period.png, fig9_distance.png")
     return 0
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from drake_biped.reproduce import FULL, QUICK, Reproduction, check_out
+    from drake_biped.experiments import reproduce
 
-    _check_cluster_options(args)
-    profile = QUICK if args.quick else FULL
+    profile = reproduce.QUICK if args.quick else reproduce.FULL
     out = Path(args.out)
-    check_out(out, profile)
+    _check_cluster_options(args)
+    reproduce.check_out(out, profile)
     hours = profile.expected_minutes / 60
-    print(f"reproduce ({profile.name}): {len(Reproduction.STEPS)} experiments into {out}/, expected about "
-          + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
+    print(f"reproduce ({profile.name}): {len(reproduce.Reproduction.STEPS)} experiments into {out}/, expected "
+          "about " + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
           + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
-    Reproduction(out, profile, args.workers, args.scheduler).run_all()
+    with _client(args) as client:
+        reproduce.run(reproduce.ReproduceSettings(profile), out, client, workers=args.workers,
+                      scheduler=args.scheduler)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines()[:40] if line.startswith("|")))
     print(f"wrote {out}/report.md, report.html")
     return 0
@@ -469,7 +378,7 @@ def build_parser() -> argparse.ArgumentParser:
     wmap.add_argument("--step", type=_number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
     wmap.add_argument("--t1-max", type=_number("nonnegative"), default=0.6, help="largest start t1 (s); default 0.6")
     wmap.add_argument("--t2-max", type=_number("positive"), default=0.9, help="largest end t2 (s); default 0.9")
-    wmap.add_argument("--workers", type=_count, default=2, help="parallel processes (default 2)")
+    _add_cluster_options(wmap)
     wmap.add_argument("--out", required=True, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
 
@@ -478,8 +387,7 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
     search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
     search.add_argument("--sigma", type=_number("positive"), default=0.1, help="mutation scale (default 0.1)")
-    search.add_argument("--workers", type=_count, default=2, help="parallel processes (default 2)")
-    search.add_argument("--out", required=True, help="output folder (rerun to resume)")
+    _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 
     ts = sub.add_parser("time-step-study", help="C_mt, speed and step period against the time step; the default")
@@ -541,7 +449,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="points per range (cell centres) of Table IV's five CPG parameters and the "
                       "initial hip angle (0-15.2 deg) and speed (0-0.35 m/s); default 2 (128 points)")
     grid.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
-                      "{values: [...]}}; see grids/")
+                      "{values: [...]}}, or a shipped one by name (around_default, slope_0.02, slope_2deg, tiny)")
     _add_resumable_run_options(grid)
     grid.set_defaults(func=cmd_grid)
 

@@ -15,8 +15,8 @@ import numpy as np
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
-from analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg
 from drake_biped import controller as ctl
+from drake_biped.analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg
 from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass

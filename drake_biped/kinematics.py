@@ -11,15 +11,8 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from drake_biped.params import (
-    CONTACT_RADIUS_M,
-    HEEL_X_M,
-    SOLE_DEPTH_M,
-    TABLE_I_LENGTHS_M,
-    TABLE_I_MASSES_KG,
-    TOE_X_M,
-    TOTAL_MASS_KG,
-)
+from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
+from drake_biped.params import CONTACT_RADIUS_M, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M, TOTAL_MASS_KG
 
 THIGH_M = TABLE_I_LENGTHS_M["thigh"]
 SHANK_M = TABLE_I_LENGTHS_M["shank"]

@@ -1,11 +1,13 @@
-"""Build the biped MultibodyPlant from `models/biped.urdf` and add the ground.
+"""Build the biped MultibodyPlant from the model file and add the ground.
 
-The robot is loaded by `package://drake_biped/biped.urdf` through `models/package.xml`, never by a path
-relative to the caller's working directory.
+The robot is loaded by `package://drake_biped/biped.urdf` through the `package.xml` shipped as package data
+(`drake_biped.models`, the repository's models/ folder), never by a path relative to the caller's working
+directory or the source tree.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,10 +25,24 @@ from pydrake.multibody.plant import (
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_biped.params import Ground
+from drake_biped.resources import model_package_xml
 
-MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
-PACKAGE_XML = MODELS_DIR / "package.xml"
 MODEL_URL = "package://drake_biped/biped.urdf"
+
+# Drake warns once per diagram (so once per worker and episode structure) that the ground's rigid half-spaces
+# take no part in deformable contact, which this toolkit does not use. That one message, by its exact text,
+# is dropped; every other message of Drake's logger passes.
+HALF_SPACE_WARNING = ("Rigid (non-deformable) half spaces are not currently supported for deformable contact; "
+                      "registration is allowed, but no contact data will be reported.")
+
+
+class _DropHalfSpaceWarning(logging.Filter):
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.getMessage() != HALF_SPACE_WARNING
+
+
+if not any(isinstance(f, _DropHalfSpaceWarning) for f in logging.getLogger("drake").filters):
+    logging.getLogger("drake").addFilter(_DropHalfSpaceWarning())
 
 # Joint order used everywhere in the toolkit (positions 3..8, velocities 3..8, actuators 0..5).
 JOINT_NAMES = (
@@ -56,7 +72,7 @@ def add_biped(
     ground: Ground,
     time_step_s: float,
     model_url: str = MODEL_URL,
-    package_xml: Path = PACKAGE_XML,
+    package_xml: Path | None = None,
     contact_approximation: str = "sap",
 ) -> PlantHandles:
     """Add the biped and the ground to `builder` and finalize the plant.
@@ -73,6 +89,7 @@ def add_biped(
     )
     plant, scene_graph = AddMultibodyPlant(config, builder)
     parser = Parser(plant)
+    package_xml = model_package_xml() if package_xml is None else Path(package_xml)
     if not package_xml.is_file():
         raise ModelError(f"model package file not found: {package_xml}")
     parser.package_map().AddPackageXml(str(package_xml))

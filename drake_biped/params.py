@@ -8,17 +8,24 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-# Table I of the paper: link lengths (m) and masses (kg).
-TABLE_I_LENGTHS_M = {"torso": 0.312, "thigh": 0.280, "shank": 0.317, "foot": 0.180}
-TABLE_I_MASSES_KG = {"torso": 6.646, "thigh": 0.673, "shank": 0.707, "foot": 0.398}
-TOTAL_MASS_KG = TABLE_I_MASSES_KG["torso"] + 2 * sum(
-    TABLE_I_MASSES_KG[k] for k in ("thigh", "shank", "foot")
+from drake_biped.paper import (
+    INITIAL_HIP_ANGLE_RAD,
+    INITIAL_SPEED_MPS,
+    TABLE_I_TOTAL_MASS_KG,
+    TABLE_III,
 )
-HIP_LIMIT_RAD = math.radians(51.0)
-ANKLE_LIMIT_RAD = math.radians(26.0)
+
+__all__ = [
+    "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
+    "SHORT_NAMES", "SimulationParams", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "CYCLE_INITIAL",
+]
+
+TOTAL_MASS_KG = TABLE_I_TOTAL_MASS_KG
 KNEE_LIMIT_RAD = (0.0, 2.4)  # 0 is full extension: the knee cannot hyper-extend.
 # Documented motor torque limits (N*m); the paper does not print them.
 EFFORT_LIMITS_NM = {"hip": 40.0, "knee": 30.0, "ankle": 20.0}
@@ -47,8 +54,13 @@ def _check_range(owner: str, name: str, value: float, lo: float | None, hi: floa
         raise ParameterError(f"{owner}.{name} = {value!r} is outside [{lo_s}, {hi_s}]")
 
 
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 class _Validated:
-    """Mixin: every float field is checked against `_RANGES` (name -> (lo, hi)) after init."""
+    """Mixin: every field is checked against its declared type after init (an int given for a float is
+    stored as a float), and every number against `_RANGES` (name -> (lo, hi)) or for being finite."""
 
     _RANGES: dict[str, tuple[float | None, float | None]] = {}
 
@@ -56,6 +68,27 @@ class _Validated:
         owner = type(self).__name__
         for f in fields(self):
             value = getattr(self, f.name)
+            kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+            optional = kind.endswith("| None")
+            kind = kind.removesuffix("| None").strip()
+            if value is None and optional:
+                continue
+            if kind == "float":
+                if not _is_number(value):
+                    raise ParameterError(f"{owner}.{f.name} must be a number, got {value!r}")
+                value = float(value)
+                object.__setattr__(self, f.name, value)
+            elif kind == "int":
+                if not isinstance(value, int) or isinstance(value, bool):
+                    raise ParameterError(f"{owner}.{f.name} must be an integer, got {value!r}")
+            elif kind == "str":
+                if not isinstance(value, str):
+                    raise ParameterError(f"{owner}.{f.name} must be a string, got {value!r}")
+            elif kind in _SECTION_CLASSES and not isinstance(value, _SECTION_CLASSES[kind]):
+                hint = (f"; build it with {kind}(...) or {kind}.from_dict(...)" if isinstance(value, dict)
+                        else "")
+                raise ParameterError(f"{owner}.{f.name} must be a {kind}, got {type(value).__name__} "
+                                     f"{value!r}{hint}")
             if f.name in self._RANGES:
                 _check_range(owner, f.name, value, *self._RANGES[f.name])
             elif isinstance(value, float):
@@ -73,11 +106,9 @@ class _Validated:
             raise ParameterError(f"{cls.__name__}: unknown parameter(s) {unknown}; known: {sorted(known)}")
         kwargs = {}
         for name, value in data.items():
-            sub = _NESTED.get((cls.__name__, name))
+            sub = _SECTIONS.get(name) if cls is EpisodeConfig else None
             if sub is not None:
                 kwargs[name] = None if value is None else sub.from_dict(value)
-            elif isinstance(value, int) and not isinstance(value, bool) and known[name].type == "float":
-                kwargs[name] = float(value)
             else:
                 kwargs[name] = value
         return cls(**kwargs)
@@ -114,7 +145,7 @@ class CpgParams(_Validated):
         return self.alpha * self.u_a / self.u_r
 
 
-PAPER_CPG = CpgParams()  # Table III as printed.
+PAPER_CPG = CpgParams(**TABLE_III)  # Table III as printed.
 
 
 @dataclass(frozen=True)
@@ -190,8 +221,8 @@ class InitialConditions(_Validated):
     0.175 m/s: an inverted pendulum of 0.6 m needs 0.33 m/s for that; as the angle between the
     thighs it needs 0.166 m/s.)"""
 
-    hip_angle_rad: float = math.radians(7.6)
-    speed_mps: float = 0.175
+    hip_angle_rad: float = INITIAL_HIP_ANGLE_RAD
+    speed_mps: float = INITIAL_SPEED_MPS
 
     _RANGES = {"hip_angle_rad": (0.0, 0.9), "speed_mps": (-2.0, 3.0)}
 
@@ -326,22 +357,63 @@ class EpisodeConfig(_Validated):
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0:
+        super().__post_init__()
+        if self.seed < 0:
             raise ParameterError(f"EpisodeConfig.seed must be a non-negative integer, got {self.seed!r}")
 
     def replace(self, **changes: Any) -> EpisodeConfig:
+        """A copy with whole sections (or the seed) replaced: `config.replace(window=TorqueFreeWindow(0.2, 0.5))`."""
         return dataclasses.replace(self, **changes)
 
+    def override(self, values: Mapping[str, Any]) -> EpisodeConfig:
+        """A copy with single fields changed, named `section.field` (`"cpg.u_a"`, `"gait.torso_pitch_rad"`,
+        `"sim.distance_m"`) or by a short name of `SHORT_NAMES` (`"u_a"`, `"kappa"`, `"t1"`, ...): the
+        names the grid specs use. Applied in order; each section is validated once it is rebuilt.
+        `EpisodeConfig().override({"u_a": 1.8, "window.end_s": 0.5})`"""
+        sections: dict[str, dict[str, Any]] = {}
+        for name, value in values.items():
+            section, attr = resolve_field(name)
+            if section not in sections:
+                current = getattr(self, section)
+                sections[section] = (current or _SECTIONS[section]()).to_dict()
+            sections[section][attr] = value
+        return self.replace(**{k: _SECTIONS[k].from_dict(v) for k, v in sections.items()})
 
-_NESTED = {
-    ("EpisodeConfig", "cpg"): CpgParams,
-    ("EpisodeConfig", "gait"): GaitParams,
-    ("EpisodeConfig", "initial"): InitialConditions,
-    ("EpisodeConfig", "window"): TorqueFreeWindow,
-    ("EpisodeConfig", "ground"): Ground,
-    ("EpisodeConfig", "push"): Push,
-    ("EpisodeConfig", "sim"): SimulationParams,
+
+_SECTIONS: dict[str, type] = {
+    "cpg": CpgParams,
+    "gait": GaitParams,
+    "initial": InitialConditions,
+    "window": TorqueFreeWindow,
+    "ground": Ground,
+    "push": Push,
+    "sim": SimulationParams,
 }
+_SECTION_CLASSES = {cls.__name__: cls for cls in _SECTIONS.values()}
+
+# Short names of single fields: the symbols of Tables III-IV, the initiation and the torque-free window.
+SHORT_NAMES = {
+    "alpha": "cpg.alpha",
+    "u_a": "cpg.u_a",
+    "u_eta": "cpg.u_eta",
+    "u_r": "cpg.u_r",
+    "kappa": "cpg.kappa",
+    "hip_angle": "initial.hip_angle_rad",
+    "speed": "initial.speed_mps",
+    "t1": "window.start_s",
+    "t2": "window.end_s",
+}
+
+
+def resolve_field(name: str) -> tuple[str, str]:
+    """(section, field) of a dotted or short field name; ParameterError naming it if there is none."""
+    dotted = SHORT_NAMES.get(name, name)
+    section, _, attr = str(dotted).partition(".")
+    cls = _SECTIONS.get(section)
+    if cls is None or attr not in {f.name for f in fields(cls)}:
+        raise ParameterError(f"{name!r} is not an EpisodeConfig field; use section.field with section in "
+                             f"{list(_SECTIONS)}, or one of {sorted(SHORT_NAMES)}")
+    return section, attr
 
 # The gait this toolkit walks by default (see README, "Model and controller choices"): found by an
 # evolutionary search (u_a = 0.3527 * u_r) for a gait that walks 10 m and in which torque-free windows

@@ -12,12 +12,17 @@ __all__ = ["versions"]
 
 @functools.lru_cache(maxsize=1)
 def versions() -> dict[str, str | None]:
-    """Package version, git commit (with '+dirty' when the tree has changes) and Drake version."""
+    """Package version, git commit of a source checkout (with '+dirty' when the tree has changes; None when
+    installed from a wheel) and Drake version."""
     from drake_biped import __version__
 
     root = Path(__file__).resolve().parent.parent
     commit = None
+    if not (root / ".git").exists():  # an installed package: its version is the code version
+        root = None
     try:
+        if root is None:
+            raise OSError("not a source checkout")
         commit = subprocess.run(
             ["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=5, check=True
         ).stdout.strip()

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg, positive_work
+from drake_biped.analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg, positive_work
 
 
 def test_positive_work_hand_computed():

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from analysis.cost_of_transport import positive_work
+from drake_biped.analysis.cost_of_transport import positive_work
 from drake_biped.diagram import TorsoPush, build_diagram
 from drake_biped.episode import EpisodeResult, run_episode
 from drake_biped.model import build_plant

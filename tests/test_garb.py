@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from drake_biped.garb import TABLE_II, GarbLearner, learning_rate
+from drake_biped.learners.garb import TABLE_II, GarbLearner, learning_rate
 
 
 def test_one_update_equals_the_hand_computed_step():

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from drake_biped.cli import main
-from drake_biped.grid import (
+from drake_biped.experiments.grid import (
     INITIATION_RANGES,
     TABLE_IV,
     Axis,
@@ -145,14 +145,13 @@ def test_grid_refuses_bad_options(tmp_path, capsys):
 
 
 def test_shipped_specs_and_parameter_files_are_valid():
-    from pathlib import Path
+    from drake_biped.resources import gait_names, grid_spec_names, load_gait
 
-    repo = Path(__file__).resolve().parent.parent
-    sizes = {p.name: len(grid_points(load_spec(p))) for p in sorted((repo / "grids").glob("*.yaml"))}
-    assert sizes == {"around_default.yaml": 64, "slope_0.02.yaml": 36, "slope_2deg.yaml": 64, "tiny.yaml": 4}
-    for p in (repo / "grids").glob("*.yaml"):
-        for point in grid_points(load_spec(p)):
+    sizes = {name: len(grid_points(load_spec(name))) for name in grid_spec_names()}
+    assert sizes == {"around_default": 64, "slope_0.02": 36, "slope_2deg": 64, "tiny": 4}
+    for name in grid_spec_names():
+        for point in grid_points(load_spec(name)):
             point_config(EpisodeConfig(), point)
-    for p in (repo / "params").glob("*.json"):  # the climbing gaits differ from the default by the grid's axes
-        config = EpisodeConfig.from_dict(json.loads(p.read_text()))
-        assert config.gait.torso_pitch_rad < EpisodeConfig().gait.torso_pitch_rad
+    assert gait_names() == ["climbing", "climbing_2deg"]
+    for name in gait_names():  # the climbing gaits differ from the default by the grid's axes
+        assert load_gait(name).gait.torso_pitch_rad < EpisodeConfig().gait.torso_pitch_rad

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from drake_biped.model import JOINT_NAMES, ModelError, add_biped, build_plant, effort_limits
-from drake_biped.params import EFFORT_LIMITS_NM, TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG, TOTAL_MASS_KG, Ground
+from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
+from drake_biped.params import EFFORT_LIMITS_NM, TOTAL_MASS_KG, Ground
 
 
 @pytest.fixture(scope="module")

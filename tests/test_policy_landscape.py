@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
-from analysis.policy_landscape import WindowRewards, expected_reward, landscape
+from drake_biped.analysis.landscape import WindowRewards, expected_reward, landscape
 
 
 def fine_grid(reward_of, step=0.01):

@@ -4,7 +4,7 @@ import re
 
 import pytest
 
-from analysis.reproduce_report import (
+from drake_biped.analysis.reproduce_report import (
     NOT_REPRODUCED,
     PARTLY,
     REPRODUCED,
@@ -14,8 +14,8 @@ from analysis.reproduce_report import (
     stability_verdict,
     table_vii_rows,
 )
+from drake_biped.experiments.reproduce import QUICK, Profile, Reproduction, check_out
 from drake_biped.params import ParameterError
-from drake_biped.reproduce import QUICK, Profile, Reproduction, check_out
 
 
 def _evaluation(reduction, windows=((0.1, 0.4, False),)):
@@ -96,9 +96,11 @@ SECTIONS = ("## The walk", "## Grid search, Table IV", "## Torque-free windows",
 
 @pytest.mark.slow
 def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_path):
+    from drake_biped.experiments.executor import dask_client
+
     logs = []
-    run = Reproduction(tmp_path, SMOKE, workers=2, log=logs.append)
-    summaries = run.run_all()
+    with dask_client(workers=2) as client:
+        summaries = Reproduction(tmp_path, SMOKE, client, workers=2, log=logs.append).run_all()
     assert list(summaries) == list(Reproduction.STEPS)
     text = (tmp_path / "report.md").read_text()
     for heading in SECTIONS:
@@ -118,6 +120,6 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     assert not summaries["slope_default"]["no_window"]["climbs"]  # the default gait does not
 
     logs.clear()
-    again = Reproduction(tmp_path, SMOKE, workers=2, log=logs.append).run_all()
+    again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append).run_all()
     assert logs == [f"[{step}] finished earlier: reused" for step in Reproduction.STEPS]
     assert again == summaries and (tmp_path / "report.md").read_text() == text

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from analysis.return_map import complex_list, fit_return_map, section_pairs, step_jacobian
+from drake_biped.analysis.return_map import complex_list, fit_return_map, section_pairs, step_jacobian
 
 P = np.array([[1.0, 0.4], [-0.3, 2.0]])  # a non-orthogonal basis: A is not symmetric
 

@@ -2,15 +2,12 @@
 short setting (2 m level, then 2 m up 0.02 rad)."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from drake_biped.cli import main
-from drake_biped.garb import GarbLearner
-from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
-from drake_biped.slope import (
+from drake_biped.experiments.slope import (
     moving_average,
     period,
     run_slope,
@@ -19,8 +16,9 @@ from drake_biped.slope import (
     start_from_window,
     trial_summary,
 )
-
-CLIMBING_GAIT = Path(__file__).resolve().parent.parent / "params" / "climbing_gait.json"
+from drake_biped.learners.garb import GarbLearner
+from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
+from drake_biped.resources import load_gait
 
 
 def test_a_restarted_learner_keeps_the_policy_and_starts_the_schedule_again():
@@ -101,10 +99,10 @@ def test_slope_story_on_a_short_setting(tmp_path):
     """2 m level, then 2 m up 0.02 rad. The default gait does not climb. The climbing gait found by the
     grid search climbs without a torque-free period and falls with the 0.2-0.4 s period that saves energy
     on level ground; a rerun recomputes nothing."""
-    from drake_biped.parallel import dask_client
+    from drake_biped.experiments.executor import dask_client
 
     sim = SimulationParams(distance_m=4.0, max_time_s=20.0)
-    climbing = EpisodeConfig.from_dict(json.loads(CLIMBING_GAIT.read_text())).replace(sim=sim)
+    climbing = load_gait("climbing").replace(sim=sim)
     ground = slope_ground(0.02, 2.0)
     state, source = start_from_window(0.2, 0.4, 1e-4)  # a tiny variance: samples stay at the period
     with dask_client(workers=2) as client:

@@ -6,9 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.stability_report import report_markdown, write_stability_outputs
-from drake_biped.params import EpisodeConfig, InitialConditions, ParameterError, SimulationParams
-from drake_biped.stability import (
+from drake_biped.analysis.stability_report import report_markdown, write_stability_outputs
+from drake_biped.experiments.stability import (
     StabilitySettings,
     analyse,
     cell_configs,
@@ -17,6 +16,7 @@ from drake_biped.stability import (
     section_sequence,
     trial_initial,
 )
+from drake_biped.params import EpisodeConfig, InitialConditions, ParameterError, SimulationParams
 
 P = np.array([[1.0, 0.3], [-0.2, 1.5]])
 
@@ -122,7 +122,7 @@ def test_bad_settings_are_refused():
 
 
 def test_a_rerun_recomputes_nothing(tmp_path):
-    from drake_biped.parallel import dask_client
+    from drake_biped.experiments.executor import dask_client
 
     base = EpisodeConfig(sim=SimulationParams(distance_m=1.2, max_time_s=6.0))
     s = StabilitySettings(trials=1, steady_from_step=1, bootstrap=0)
@@ -159,7 +159,7 @@ class _ThresholdClient:
 
 
 def test_push_margin_brackets_each_threshold_within_the_tolerance():
-    from drake_biped.stability import push_margin
+    from drake_biped.experiments.push_margin import push_margin
 
     limits = {("without", "forward"): 37.3, ("without", "backward"): 61.0,
               ("with", "forward"): 12.25, ("with", "backward"): 250.0}
@@ -205,7 +205,7 @@ class _LinearStepClient:
 
 
 def test_finite_difference_jacobian_recovers_a_known_step_map():
-    from drake_biped.stability import finite_difference_jacobian
+    from drake_biped.experiments.stability import finite_difference_jacobian
 
     j_true = a_with([0.3 + 0.2j, 0.3 - 0.2j])
     m = np.array([[0.8, 0.05], [-2.0, 0.9]])  # a kick moves both section coordinates

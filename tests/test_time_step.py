@@ -3,7 +3,7 @@
 import pytest
 
 from drake_biped.cli import main
-from drake_biped.time_step import choose_step
+from drake_biped.experiments.time_step import choose_step
 
 STEPS = [0.00025, 0.0005, 0.001, 0.002, 0.005]
 

@@ -25,22 +25,15 @@ from typing import Any
 
 import numpy as np
 
-from analysis.return_map import complex_list, fit_return_map, least_squares_map
+from drake_biped.analysis.return_map import complex_list, fit_return_map, least_squares_map
+from drake_biped.paper import TABLE_VI
 from drake_biped.params import EpisodeConfig, InitialConditions, ParameterError, Push, TorqueFreeWindow
 from drake_biped.versions import versions
 
 CONDITIONS = ("without", "with")
 DISTURBANCES = ("undisturbed", "forward", "backward")
 
-# Table VI of the paper: eigenvalues of the return map, as (real, imaginary) pairs.
-TABLE_VI_PAPER: dict[str, dict[str, list[tuple[float, float]]]] = {
-    "without": {"undisturbed": [(0.064, 0.101), (0.064, -0.101)],
-                "forward": [(0.318, 0.0), (-0.234, 0.0)],
-                "backward": [(0.378, 0.0), (-0.109, 0.0)]},
-    "with": {"undisturbed": [(-0.200, 0.0), (0.129, 0.0)],
-             "forward": [(0.140, 0.164), (0.140, -0.164)],
-             "backward": [(0.326, 0.0), (0.0345, 0.0)]},
-}
+TABLE_VI_PAPER = TABLE_VI  # eigenvalues of the return map, as (real, imaginary) pairs
 
 
 @dataclass(frozen=True)
@@ -183,8 +176,8 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
                   jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD) -> dict[str, Any]:
     """Run (or finish) the six cells on Dask, then the finite-difference Jacobian of each condition's step
     map at each kick size, and return the stability record. Finished parts are read back on a rerun."""
-    from drake_biped.learning import write_atomic
-    from drake_biped.parallel import run_kept
+    from drake_biped.experiments.executor import run_kept
+    from drake_biped.records import write_atomic
 
     code = versions()  # recorded at the start: the code this process runs
     (out / "episodes").mkdir(parents=True, exist_ok=True)
@@ -223,62 +216,6 @@ def survives(result: dict[str, Any], distance_m: float) -> bool:
     return (not result["fell"]) and result["distance_m"] >= distance_m - 1e-6
 
 
-def push_margin(base: EpisodeConfig, window: tuple[float, float], client, max_force_n: float = 200.0,
-                tolerance_n: float = 1.0, push_start_s: float = 0.4, push_duration_s: float = 0.1,
-                progress: Callable[[int], None] | None = None) -> dict[str, Any]:
-    """The largest forward and backward push (N over `push_duration_s`, from `push_start_s`) after which the
-    gait still walks its distance, without and with the torque-free period `window`, by bisection.
-
-    Four bisections (condition x direction) advance together, one round of four episodes at a time. Each
-    assumes survival is monotonic in the force between 0 and `max_force_n`; the record keeps every episode
-    tried, so a non-monotonic case shows. The margin is the largest force that survived (its bracket's
-    upper end is the smallest that fell, or `max_force_n` if none fell)."""
-    from drake_biped.parallel import episode_task
-
-    if not (math.isfinite(max_force_n) and max_force_n > 0 and math.isfinite(tolerance_n) and tolerance_n > 0):
-        raise ParameterError(f"max force {max_force_n!r} and tolerance {tolerance_n!r} must be > 0")
-    distance = base.sim.distance_m
-    chains = {}
-    for condition in CONDITIONS:
-        w = condition_window(condition, window)
-        for direction, sign in (("forward", 1.0), ("backward", -1.0)):
-            chains[(condition, direction)] = {"window": w, "sign": sign, "lo": 0.0, "hi": None, "tried": []}
-
-    def config(chain, force):
-        return base.replace(window=chain["window"],
-                            push=Push(chain["sign"] * force, push_start_s, push_duration_s)).to_dict()
-
-    # First round: the largest force; then bisect where it fell.
-    rounds = 0
-    pending = {key: max_force_n for key in chains}
-    while pending:
-        keys = list(pending)
-        futures = [client.submit(episode_task, config(chains[k], pending[k]), pure=False) for k in keys]
-        for key, result in zip(keys, client.gather(futures)):
-            c, force = chains[key], pending[key]
-            ok = survives(result, distance)
-            c["tried"].append({"force_n": force, "survived": ok, "distance_m": result["distance_m"],
-                               "fall_reason": result["fall_reason"]})
-            if ok:
-                c["lo"] = max(c["lo"], force)
-            else:
-                c["hi"] = force if c["hi"] is None else min(c["hi"], force)
-        rounds += 1
-        if progress:
-            progress(rounds)
-        pending = {}
-        for key, c in chains.items():
-            if c["hi"] is not None and c["hi"] - c["lo"] > tolerance_n:
-                pending[key] = 0.5 * (c["lo"] + c["hi"])
-    out: dict[str, Any] = {"window": list(window), "max_force_n": max_force_n, "tolerance_n": tolerance_n,
-                           "push_start_s": push_start_s, "push_duration_s": push_duration_s, "margins": {}}
-    for (condition, direction), c in chains.items():
-        out["margins"].setdefault(condition, {})[direction] = {
-            "survived_n": c["lo"], "fell_n": c["hi"], "impulse_ns": c["lo"] * push_duration_s,
-            "tried": c["tried"]}
-    return out
-
-
 def _section(result: dict[str, Any], index: int) -> np.ndarray | None:
     for s in result["steps"]:
         if s["index"] == index:
@@ -302,7 +239,7 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle
     jumps where a touchdown moves across an update; a pair of kicks can land on either side of one, and many
     kicks average them out, as the regression does with pushes. The residual says how large they are.
     """
-    from drake_biped.parallel import episode_task
+    from drake_biped.experiments.executor import episode_task
 
     if not isinstance(step, int) or step < 2:
         raise ParameterError(f"step {step!r}: must be an integer >= 2")
@@ -356,3 +293,36 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle
         "relative_residual": float(np.linalg.norm(res) / max(np.linalg.norm(dy), 1e-300)),
         "dx_condition_number": float(np.linalg.cond(dx)),
     }
+
+
+def run(settings: StabilitySettings, out: Path, client=None, progress: bool = True, config: EpisodeConfig | None = None,
+        jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD) -> dict[str, Any]:
+    """The six cells and the Jacobians of `config`'s gait (the default gait when None) on `client` (a
+    LocalCluster when None), with a progress bar; writes episodes/, stability.json, fig7_return_map.png,
+    report.md and report.html into `out`. The record."""
+    from drake_biped.analysis.stability_report import write_stability_outputs
+    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.records import write_atomic
+
+    out = Path(out)
+    config = config or EpisodeConfig()
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=6 * settings.trials, desc="stability", unit="episode")
+
+    def report(done: int, total: int) -> None:
+        bar.n = done
+        bar.refresh()
+
+    try:
+        with client_or_local(client) as c:
+            record = run_stability(out, config, settings, c, report if bar is not None else None,
+                                   jacobian_kicks=jacobian_kicks)
+    finally:
+        if bar is not None:
+            bar.close()  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
+    write_atomic(out / "stability.json", record)
+    write_stability_outputs(record, out)
+    return record

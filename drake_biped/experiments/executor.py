@@ -1,8 +1,9 @@
-"""Run independent episodes on Dask: an embedded LocalCluster by default, or an existing scheduler.
+"""The one executor of every parallel experiment: Dask, on an embedded LocalCluster by default, or on an
+existing scheduler given its address (`--workers N | --scheduler ADDR` on every parallel command).
 
-Workers receive numbers (EpisodeConfig dictionaries), never Drake objects, and build their own diagrams.
-Scripts that start a LocalCluster spawn worker processes, so their entry point needs the
-`if __name__ == "__main__":` guard.
+Workers receive numbers (EpisodeConfig dictionaries), never Drake objects (they do not pickle), and build
+their own diagrams; the toolkit must be installed on every worker. Scripts that start a LocalCluster spawn
+worker processes, so their entry point needs the `if __name__ == "__main__":` guard.
 """
 
 from __future__ import annotations
@@ -27,6 +28,16 @@ def check_scheduler_address(address: str) -> str:
     if not isinstance(address, str) or not _ADDRESS.match(address):
         raise ParameterError(f"--scheduler {address!r}: expected an address like tcp://HOST:PORT")
     return address
+
+
+@contextmanager
+def client_or_local(client: Any = None) -> Iterator[Any]:
+    """`client` itself when given, else a LocalCluster's client for the duration of the block."""
+    if client is not None:
+        yield client
+        return
+    with dask_client() as local:
+        yield local
 
 
 @contextmanager
@@ -101,7 +112,7 @@ def run_kept(
 
     from distributed import as_completed
 
-    from drake_biped.learning import write_atomic
+    from drake_biped.records import write_atomic
 
     results: dict[Any, dict[str, Any]] = {}
     todo = {}

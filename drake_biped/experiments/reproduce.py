@@ -34,15 +34,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import PAPER_CPG, EpisodeConfig, InitialConditions, ParameterError, TorqueFreeWindow
+from drake_biped.records import write_atomic
+from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-REPO = Path(__file__).resolve().parent.parent
-PARAMS_DIR = REPO / "params"
+__all__ = ["FULL", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run"]
+
 LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none under pushes (as `stability` defaults)
 SLOPE_START = {"slope": (0.1, 0.6), "slope2deg": (0.1, 0.7)}  # each climbing gait's best level window
-PAPER_REDUCTION = 1.0 - 0.29 / 0.58
-TABLE_VII_PAPER = {"u_a": (2.0, 2.74), "u_r": (2.1, 2.63), "kappa": (1.8, 2.72)}  # Table III -> Table VII
+SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
 
 
 @dataclass(frozen=True)
@@ -75,21 +77,14 @@ FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 10
                (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 150.0)
 
 
-def params_file(name: str) -> EpisodeConfig:
-    """A parameter file shipped in params/."""
-    path = PARAMS_DIR / name
-    try:
-        return EpisodeConfig.from_dict(json.loads(path.read_text()))
-    except (OSError, json.JSONDecodeError) as exc:
-        raise ParameterError(f"reproduce: cannot read the parameter file {path} ({exc})") from None
-
-
 class Reproduction:
-    """The output folder, the profile, the cluster options; runs each experiment once."""
+    """The output folder, the profile, the Dask client; runs each experiment once. `workers`/`scheduler`:
+    what the run logs record of the cluster."""
 
-    def __init__(self, out: Path, profile: Profile, workers: int | None = None, scheduler: str | None = None,
-                 log: Callable[[str], None] = print):
-        self.out, self.profile, self.workers, self.scheduler, self.log = out, profile, workers, scheduler, log
+    def __init__(self, out: Path, profile: Profile, client, workers: int | None = None,
+                 scheduler: str | None = None, log: Callable[[str], None] = print):
+        self.out, self.profile, self._client = out, profile, client
+        self.workers, self.scheduler, self.log = workers, scheduler, log
 
     @property
     def level(self) -> EpisodeConfig:
@@ -99,14 +94,13 @@ class Reproduction:
                                                     max_time_s=max(base.sim.max_time_s, 6 * self.profile.distance_m)))
 
     def client(self):
-        from drake_biped.parallel import dask_client
+        """The reproduction's one client, as a context (it is closed by whoever opened it)."""
+        from drake_biped.experiments.executor import client_or_local
 
-        return dask_client(workers=self.workers, scheduler=self.scheduler)
+        return client_or_local(self._client)
 
     def experiment(self, name: str, settings: dict[str, Any], fn: Callable[[Path], dict[str, Any]]) -> dict:
         """fn(folder) -> summary, unless DIR/name/summary.json holds one made with these settings."""
-        from drake_biped.learning import write_atomic
-
         folder = self.out / name
         path = folder / "summary.json"
         if path.is_file():
@@ -126,10 +120,10 @@ class Reproduction:
     # The experiments, in the order they run. Each returns its summary (what the report needs).
 
     def walk(self) -> dict:
-        from drake_biped.outputs import write_walk
+        from drake_biped.experiments import walk
 
         def run(folder: Path) -> dict:
-            r = write_walk(self.level, folder)
+            r = walk.run(walk.WalkSettings(self.level), folder, progress=False)
             return {"distance_m": r.distance_m, "fell": r.fell, "cost_of_transport": r.cost_of_transport,
                     "mean_speed_mps": r.mean_speed_mps, "step_period_s": r.step_period_s,
                     "real_time_factor": r.real_time_factor}
@@ -137,20 +131,21 @@ class Reproduction:
         return self.experiment("walk", {"distance_m": self.profile.distance_m}, run)
 
     def time_step(self) -> dict:
-        from drake_biped.time_step import run_study
+        from drake_biped.experiments import time_step
 
         p = self.profile
         settings = {"steps": list(p.time_steps), "distance_m": p.time_step_distance_m}
 
         def run(folder: Path) -> dict:
-            rec = run_study(folder, list(p.time_steps), 0.0005, p.time_step_distance_m, self.workers, self.scheduler)
+            rec = time_step.run(time_step.TimeStepSettings(tuple(p.time_steps), 0.0005, p.time_step_distance_m),
+                                folder, self._client, progress=False)
             return {"chosen_step_s": rec["chosen_step_s"], "passing_steps": rec["passing_steps"]}
 
         return self.experiment("time_step", settings, run)
 
     def grid(self) -> dict:
-        from drake_biped.grid import run_grid, table_iv_axes
-        from drake_biped.parallel import run_kept
+        from drake_biped.experiments.executor import run_kept
+        from drake_biped.experiments.grid import run_grid, table_iv_axes
 
         p = self.profile
         settings = {"points": p.grid_points, "initiation_points": p.grid_initiation_points,
@@ -169,12 +164,13 @@ class Reproduction:
         return self.experiment("grid", settings, run)
 
     def window_map(self) -> dict:
-        from drake_biped.window_map import run_window_map
+        from drake_biped.experiments import window_map
 
         step = self.profile.window_step_s
 
         def run(folder: Path) -> dict:
-            rec = run_window_map(self.level, folder, t1_step=step, t2_step=step, workers=self.workers or 2)
+            rec = window_map.run(window_map.WindowMapSettings(self.level, t1_step_s=step, t2_step_s=step), folder,
+                                 self._client, progress=False)
             walked = [w for w in rec["windows"] if w["walked"]]
             best = min(walked, key=lambda w: w["cost_of_transport"], default=None)
             return {"no_window_cost_of_transport": rec["baseline"]["cost_of_transport"],
@@ -185,12 +181,12 @@ class Reproduction:
         return self.experiment("window_map", {"step_s": step, "distance_m": self.profile.distance_m}, run)
 
     def _learn(self, name: str, trials: int, episodes: int, mean, variance: float) -> dict:
-        from drake_biped.learning import learn, make_settings
+        from drake_biped.experiments import learning
 
-        settings = make_settings(self.level, trials, episodes, 0, mean=mean, variance=variance)
+        settings = learning.LearningSettings(self.level, trials, episodes, 0, mean=mean, variance=variance).record()
 
         def run(folder: Path) -> dict:
-            record = learn(folder, settings, workers=self.workers, scheduler=self.scheduler)
+            record = learning.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler)
             ev = record["evaluation"]
             run_log = json.loads((folder / "run.json").read_text())
             return {"evaluation": ev, "episodes_per_min": run_log["episodes_per_min"]}
@@ -206,19 +202,14 @@ class Reproduction:
         return self._learn("learn_variant", trials, episodes, (0.4, 0.4), 0.01)
 
     def stability(self) -> dict:
-        from analysis.stability_report import write_stability_outputs
-        from drake_biped.learning import write_atomic
-        from drake_biped.stability import JACOBIAN_KICKS_RAD, StabilitySettings, run_stability
+        from drake_biped.experiments import stability
 
         p = self.profile
-        settings = StabilitySettings(window=LEVEL_WINDOW, trials=p.stability_trials)
+        settings = stability.StabilitySettings(window=LEVEL_WINDOW, trials=p.stability_trials)
 
         def run(folder: Path) -> dict:
-            with self.client() as client:
-                record = run_stability(folder, self.level, settings, client,
-                                       jacobian_kicks=JACOBIAN_KICKS_RAD if p.jacobian else ())
-            write_atomic(folder / "stability.json", record)
-            write_stability_outputs(record, folder)
+            record = stability.run(settings, folder, self._client, progress=False, config=self.level,
+                                   jacobian_kicks=stability.JACOBIAN_KICKS_RAD if p.jacobian else ())
             cells = {c: {k: {key: record["cells"][c][k].get(key) for key in
                              ("spectral_radius", "spectral_radius_ci", "eigenvalues", "falls", "trials", "stable",
                               "paper_spectral_radius", "paper_eigenvalues")}
@@ -229,13 +220,13 @@ class Reproduction:
                                              "distance_m": p.distance_m}, run)
 
     def push_margin(self) -> dict:
-        from drake_biped.stability import push_margin
+        from drake_biped.experiments import push_margin
 
         tol = self.profile.margin_tolerance_n
 
         def run(folder: Path) -> dict:
-            with self.client() as client:
-                record = push_margin(self.level, LEVEL_WINDOW, client, max_force_n=200.0, tolerance_n=tol)
+            record = push_margin.run(push_margin.PushMarginSettings(self.level, LEVEL_WINDOW, 200.0, tol), folder,
+                                     self._client, progress=False)
             return {"margins": {c: {d: record["margins"][c][d]["survived_n"] for d in ("forward", "backward")}
                                 for c in ("without", "with")}}
 
@@ -243,32 +234,31 @@ class Reproduction:
                                                "distance_m": self.profile.distance_m}, run)
 
     def slope_default(self) -> dict:
-        from drake_biped.parallel import run_kept
-        from drake_biped.slope import climbs, slope_ground
+        from drake_biped.experiments.executor import run_kept
+        from drake_biped.experiments.slope import climbs, slope_ground
 
         def run(folder: Path) -> dict:
-            config = EpisodeConfig().replace(ground=slope_ground(0.02))
+            config = EpisodeConfig().replace(ground=slope_ground(SLOPE_RAD))
             jobs = {"no_window": config, "window": config.replace(window=TorqueFreeWindow(*LEVEL_WINDOW))}
             with self.client() as client:
                 results = run_kept(client, {k: (folder / f"{k}.json", c.to_dict()) for k, c in jobs.items()})
             return {k: {"distance_m": r["distance_m"], "climbs": climbs(r)} for k, r in results.items()}
 
-        return self.experiment("slope_default", {"slope_rad": 0.02, "window": list(LEVEL_WINDOW)}, run)
+        return self.experiment("slope_default", {"slope_rad": SLOPE_RAD, "window": list(LEVEL_WINDOW)}, run)
 
     def _slope_grid(self, name: str, spec: str, base_file: str | None, slope: float,
                     subset: dict[str, list[float]]):
-        """A grid on 2 m level then `slope`, from the default gait (base_file None) or a params/ file: the
-        spec file in grids/ (full), or the 2 x 2 `subset` through its best (quick)."""
-        from drake_biped.grid import Axis, field_name, load_spec, run_grid
-        from drake_biped.slope import slope_ground
+        """A grid on 2 m level then `slope`, from the default gait (base_file None) or a shipped gait: the
+        shipped grid spec `spec` (full), or the 2 x 2 `subset` through its best (quick)."""
+        from drake_biped.experiments.grid import Axis, field_name, load_spec, run_grid
+        from drake_biped.experiments.slope import slope_ground
 
         full = self.profile.slope_grid_full
         settings = {"spec": spec if full else subset, "base": base_file, "slope_rad": slope}
 
         def run(folder: Path) -> dict:
-            axes = load_spec(REPO / "grids" / spec) if full else [Axis(field_name(k), tuple(v))
-                                                                   for k, v in subset.items()]
-            base = (EpisodeConfig() if base_file is None else params_file(base_file)).replace(ground=slope_ground(slope))
+            axes = load_spec(spec) if full else [Axis(field_name(k), tuple(v)) for k, v in subset.items()]
+            base = (EpisodeConfig() if base_file is None else load_gait(base_file)).replace(ground=slope_ground(slope))
             with self.client() as client:
                 record = run_grid(folder, base, axes, client)
             return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
@@ -277,15 +267,15 @@ class Reproduction:
         return self.experiment(name, settings, run)
 
     def grid_slope(self) -> dict:
-        return self._slope_grid("grid_slope", "slope_0.02.yaml", None, 0.02,
+        return self._slope_grid("grid_slope", "slope_0.02", None, SLOPE_RAD,
                                 {"gait.torso_pitch_rad": [-0.2226, -0.30], "gait.placement_gain": [0.356, 0.45]})
 
     def grid_slope2deg(self) -> dict:
-        return self._slope_grid("grid_slope2deg", "slope_2deg.yaml", "climbing_gait.json", 0.0349,
+        return self._slope_grid("grid_slope2deg", "slope_2deg", "climbing", SLOPE_2DEG_RAD_PRINTED,
                                 {"gait.torso_pitch_rad": [-0.34, -0.38], "u_a": [1.6291, 2.0]})
 
     def _slope(self, name: str, base_file: str, slope: float) -> dict:
-        from drake_biped.slope import run_slope, slope_ground, start_from_window
+        from drake_biped.experiments import slope as slope_experiment
 
         trials, episodes = self.profile.slope
         t1, t2 = SLOPE_START[name]
@@ -293,20 +283,19 @@ class Reproduction:
                     "trials": trials, "episodes": episodes}
 
         def run(folder: Path) -> dict:
-            state, source = start_from_window(t1, t2, 0.04)
-            source["params"] = f"params/{base_file}"
-            with self.client() as client:
-                record = run_slope(folder, params_file(base_file), slope_ground(slope), state, source, trials,
-                                   episodes, 0, client)
+            record = slope_experiment.run(
+                slope_experiment.SlopeSettings(load_gait(base_file), slope, window=(t1, t2), variance=0.04,
+                                               trials=trials, episodes=episodes, gait=base_file),
+                folder, self._client, progress=False, workers=self.workers, scheduler=self.scheduler)
             return {k: record[k] for k in ("checks", "verdicts", "trials", "start")}
 
         return self.experiment(name, settings, run)
 
     def slope(self) -> dict:
-        return self._slope("slope", "climbing_gait.json", 0.02)
+        return self._slope("slope", "climbing", SLOPE_RAD)
 
     def slope2deg(self) -> dict:
-        return self._slope("slope2deg", "climbing_gait_2deg.json", 0.0349)
+        return self._slope("slope2deg", "climbing_2deg", SLOPE_2DEG_RAD_PRINTED)
 
     STEPS = ("walk", "time_step", "grid", "window_map", "learn", "learn_variant", "stability", "push_margin",
              "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
@@ -317,10 +306,31 @@ class Reproduction:
         summaries = {}
         for step in self.STEPS:
             summaries[step] = getattr(self, step)()
-        from analysis.reproduce_report import write_report
+        from drake_biped.analysis.reproduce_report import write_report
 
         write_report(self.out, summaries, self.profile, code)
         return summaries
+
+
+@dataclass(frozen=True)
+class ReproduceSettings:
+    """Which profile: QUICK (minutes) or FULL (hours)."""
+
+    profile: Profile = QUICK
+
+
+def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = True,
+        workers: int | None = None, scheduler: str | None = None) -> dict[str, dict]:
+    """Every experiment into its folder of `out` on `client` (a LocalCluster when None), then report.md,
+    report.html and report_summary.png; reuses finished experiments and resumes the unfinished one. The
+    experiments' summaries."""
+    from drake_biped.experiments.executor import client_or_local
+
+    out = Path(out)
+    check_out(out, settings.profile)
+    with client_or_local(client) as c:
+        return Reproduction(out, settings.profile, c, workers, scheduler,
+                            log=print if progress else (lambda _: None)).run_all()
 
 
 def check_out(out: Path, profile: Profile) -> None:
@@ -331,5 +341,5 @@ def check_out(out: Path, profile: Profile) -> None:
         if saved != profile.name:
             raise ParameterError(f"--out {out} holds a {saved!r} run; use another folder for a {profile.name!r} run")
     out.mkdir(parents=True, exist_ok=True)
-    marker.write_text(json.dumps(profile.to_dict(), indent=1) + "\n")
+    write_atomic(marker, profile.to_dict())
 

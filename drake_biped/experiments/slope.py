@@ -13,7 +13,7 @@ The learner starts from the learned policy's state: its mean, variance and eligi
 says "the learning algorithm and α_p were not changed"; here the episode count starts again at 1 on the new
 ground, so α_p follows Table II from its first band (carrying the count over would leave α_p at 0.001 after
 a 500-episode level run, and the period could not move in tens of episodes), and the baseline becomes the
-running mean of the slope's rewards. Reward and fall rule are the level run's (`learning.reward`).
+running mean of the slope's rewards. Reward and fall rule are the level run's (`analysis.reward`).
 
 Nothing lost: the learning runs through `learning.run_learning` (each trial's record rewritten after every
 episode, resumed on rerun) and the check episodes are kept in OUT/checks/ and reused.
@@ -24,18 +24,21 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from analysis.series import moving_average
-from drake_biped.garb import GarbLearner
-from drake_biped.learning import make_settings, run_learning, trial_seed, window_of, write_atomic
+from drake_biped.analysis.series import moving_average, period
+from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
+from drake_biped.learners.garb import GarbLearner
+from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
 from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow
+from drake_biped.records import write_atomic
 from drake_biped.versions import versions
 
-MOVING_AVERAGE = 20  # episodes, as in the paper's Figs. 8-11
+MOVING_AVERAGE = SLOPE_MOVING_AVERAGE  # episodes, as in the paper's Figs. 8-11
 
 
 def slope_ground(slope_rad: float, level_length_m: float = 2.0, friction: float = 1.0) -> Ground:
@@ -48,7 +51,8 @@ def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
     """The learner state of a level-ground run's best learned trial (`learning.best_learned_trial`), read
     from its record OUT/trials/trial_K.json beside the learning.json; and a description of where it came
     from."""
-    from drake_biped.learning import best_learned_trial, read_json
+    from drake_biped.experiments.learning import best_learned_trial
+    from drake_biped.records import read_json
 
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
     trial_path = path.parent / "trials" / f"trial_{row['trial']}.json"
@@ -71,7 +75,7 @@ def start_from_window(t1: float, t2: float, variance: float) -> tuple[dict[str, 
 
 def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[str, dict[str, Any]]:
     """One episode per named configuration, kept in OUT/checks/ and reused when its configuration matches."""
-    from drake_biped.parallel import run_kept
+    from drake_biped.experiments.executor import run_kept
 
     return run_kept(client, {name: (out / "checks" / f"{name}.json", c.to_dict()) for name, c in configs.items()})
 
@@ -84,12 +88,6 @@ def climbs(result: dict[str, Any]) -> bool:
 def _summary(result: dict[str, Any]) -> dict[str, Any]:
     keep = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps")
     return {**{k: result[k] for k in keep}, "climbs": climbs(result)}
-
-
-def period(t1: float, t2: float) -> float:
-    """Length of the torque-free period a (t1, t2) sample or mean gives: t2 - t1 with times below 0 acting
-    as 0, and 0 when t2 <= t1."""
-    return float(max(0.0, max(0.0, t2) - max(0.0, t1)))
 
 
 def trial_summary(episodes: list[dict[str, Any]], distance_m: float) -> dict[str, Any]:
@@ -120,7 +118,7 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
               progress: Callable[[int, int, float | None], None] | None = None) -> dict[str, Any]:
     """Run (or finish) the checks and the online learning on the slope; write slope.json and the figures;
     return the record."""
-    from analysis.figures import slope_figures
+    from drake_biped.analysis.figures import slope_figures
 
     code = versions()
     out.mkdir(parents=True, exist_ok=True)
@@ -215,3 +213,55 @@ def report_markdown(record: dict[str, Any]) -> str:
     lines += ["", "Figures: fig8_period.png (the paper's Fig. 8, or Fig. 10 at 2.0°), fig9_distance.png "
               "(Fig. 9 / Fig. 11).", ""]
     return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class SlopeSettings:
+    """A slope run: the gait `config` on `level_length_m` of level ground then `slope_rad` up; the learner
+    starts from the best learned trial of the learning record `policy`, or else from the window (t1, t2)
+    with `variance`; `trials` x `episodes` of online learning. `gait` names the shipped gait for the record."""
+
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    slope_rad: float = SLOPE_RAD
+    level_length_m: float = SLOPE_LEVEL_LENGTH_M
+    policy: str | None = None
+    window: tuple[float, float] = (0.2, 0.5)
+    variance: float = GARB_VARIANCE_S2
+    trials: int = 2
+    episodes: int = 100
+    seed: int = 0
+    gait: str | None = None
+
+    def ground(self) -> Ground:
+        return slope_ground(self.slope_rad, self.level_length_m, self.config.ground.friction)
+
+    def start(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The learner state to start from and where it came from."""
+        if self.policy is not None:
+            state, source = start_from_learning(Path(self.policy))
+        else:
+            state, source = start_from_window(*self.window, self.variance)
+        if self.gait is not None:
+            source["params"] = self.gait
+        return state, source
+
+
+def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
+        workers: int | None = None, scheduler: str | None = None) -> dict[str, Any]:
+    """The checks and the online learning on `client` (a LocalCluster when None), with a progress bar and
+    OUT/run.json; writes slope.json, report.md, fig8_period.png, fig9_distance.png, checks/, trials/."""
+    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import RunProgress
+
+    out = Path(out)
+    ground = settings.ground()
+    state, source = settings.start()
+    report = RunProgress(out, workers, scheduler, "slope learning", "episode", bar=progress)
+    try:
+        with client_or_local(client) as c:
+            record = run_slope(out, settings.config, ground, state, source, settings.trials, settings.episodes,
+                               settings.seed, c, report)
+    finally:
+        report.close()
+    report.log.update(report.new, finished=True)
+    return record

@@ -6,7 +6,7 @@ or lie next to windows that fall, J can be highest with no window at all even th
 a lot; the learner then converges, correctly, to no window. This module estimates J from measured episodes
 (a window map) so that a choice of σ² and start can be checked before thousands of episodes are spent.
 
-The reward of a sampled t follows the learning run exactly (`drake_biped.learning.reward`, times below 0
+The reward of a sampled t follows the learning run exactly (`drake_biped.analysis.reward`, times below 0
 act as 0, t2 <= t1 means no window); a window between grid points takes the reward of the nearest measured
 window (the map's spacing bounds the resolution). Plain numpy and scipy.
 """
@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 from scipy.spatial import cKDTree
+
+from drake_biped.analysis.reward import reward
 
 
 class WindowRewards:
@@ -36,8 +38,6 @@ class WindowRewards:
     @classmethod
     def from_window_map(cls, record: dict[str, Any]) -> WindowRewards:
         """From a `window_map.json` record (drake-biped window-map)."""
-        from drake_biped.learning import reward
-
         target = record["config"]["sim"]["distance_m"]
         base = record["baseline"]
         rows = record["windows"]
@@ -91,34 +91,3 @@ def landscape(rewards: WindowRewards, variances: Sequence[float], t1_range=(0.0,
                         "gain": float(v / base - 1.0) if base > 0 else None} for s, v in zip(starts, at)],
         })
     return out
-
-
-def landscape_figure(record: dict[str, Any], path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    cells = record["variances"]
-    base = record["no_window_reward"]
-    fig, axes = plt.subplots(1, len(cells), figsize=(4.6 * len(cells), 4.2), squeeze=False)
-    t1, t2 = np.array(record["t1"]), np.array(record["t2"])
-    for ax, cell in zip(axes[0], cells):
-        gain = 100.0 * (np.array(cell["expected_reward"]) / base - 1.0)
-        lim = max(1.0, float(np.nanmax(np.abs(gain))))
-        im = ax.pcolormesh(t1, t2, gain, cmap="RdBu", vmin=-lim, vmax=lim, shading="nearest")
-        ax.contour(t1, t2, gain, levels=[0.0], colors="k", linewidths=0.8)
-        ax.plot(*cell["best_mean"], "k*", ms=12, label=f"max J: {100 * cell['best_gain']:+.0f} %")
-        for s in cell["starts"]:
-            ax.plot(*s["mean"], "ko", mfc="none", ms=8, label=f"start {tuple(s['mean'])}: {100 * s['gain']:+.0f} %")
-        ax.plot([0, min(t1[-1], t2[-1])], [0, min(t1[-1], t2[-1])], "k:", lw=0.8)
-        ax.set_title(f"σ² = {cell['variance']:g} s²", fontsize=10)
-        ax.set_xlabel("policy mean t̄1 [s]")
-        ax.set_ylabel("policy mean t̄2 [s]")
-        ax.legend(fontsize=7, loc="upper left")
-        fig.colorbar(im, ax=ax, label="expected reward vs no window [%]")
-    fig.suptitle("What GARB climbs: expected reward of N(T̄, σ²I) over measured windows (below the dotted "
-                 "line: no window)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
-from drake_biped.parallel import dask_client, episode_task, map_ordered
+from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams, TorqueFreeWindow
+from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
 WALKS = [None, (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7)]
@@ -25,7 +27,7 @@ def label(window) -> str:
     return "no window" if window is None else f"window {window[0]:g}–{window[1]:g} s"
 
 
-def study(steps: list[float], reference: float, distance: float, client) -> dict:
+def study(steps: list[float], reference: float, distance: float, client, progress: bool = True) -> dict:
     jobs = []
     for h in steps:
         for w in WALKS:
@@ -34,7 +36,7 @@ def study(steps: list[float], reference: float, distance: float, client) -> dict
             jobs.append((h, w, EpisodeConfig(sim=sim, window=window).to_dict()))
     from tqdm import tqdm
 
-    with tqdm(total=len(jobs), desc="time-step study", unit="episode") as bar:
+    with tqdm(total=len(jobs), desc="time-step study", unit="episode", disable=not progress) as bar:
         results = map_ordered(client, episode_task, [j[2] for j in jobs], lambda n, r: bar.update(1))
     rows = []
     for (h, w, _), r in zip(jobs, results):
@@ -163,18 +165,32 @@ def figure(rec: dict, path: Path) -> None:
     plt.close(fig)
 
 
-def run_study(out: Path, steps: list[float], reference: float = 0.0005, distance: float = 10.0,
-              workers: int | None = None, scheduler: str | None = None) -> dict:
-    """Run the study, write its JSON, Markdown and figure into `out`, and return the record."""
-    steps = sorted(steps)
-    if reference not in steps:
-        raise ParameterError(f"--reference {reference!r} must be one of --steps {steps}")
+@dataclass(frozen=True)
+class TimeStepSettings:
+    """The time steps compared (s), the reference among them, and the distance walked."""
+
+    steps: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.005)
+    reference_s: float = 0.0005
+    distance_m: float = 10.0
+
+    def __post_init__(self) -> None:
+        if self.reference_s not in self.steps:
+            raise ParameterError(f"--reference {self.reference_s!r} must be one of --steps {sorted(self.steps)}")
+
+
+def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = True) -> dict:
+    """Run the study on `client` (a LocalCluster when None); write time_step_study.json, .md and .png into
+    `out`; return the record."""
+    from drake_biped.experiments.executor import client_or_local
+
+    out = Path(out)
+    steps = sorted(settings.steps)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    with dask_client(workers=workers, scheduler=scheduler) as client:
-        rec = study(steps, reference, distance, client)
+    with client_or_local(client) as c:
+        rec = study(steps, settings.reference_s, settings.distance_m, c, progress)
     rec.update(date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), versions=versions(), wall_s=time.perf_counter() - t0)
-    (out / "time_step_study.json").write_text(json.dumps(rec, indent=2) + "\n")
+    write_text_atomic(out / "time_step_study.json", json.dumps(rec, indent=2) + "\n")
     replot(out)
     return rec
 
@@ -182,6 +198,6 @@ def run_study(out: Path, steps: list[float], reference: float = 0.0005, distance
 def replot(out: Path) -> dict:
     """Redraw the Markdown and the figure from out/time_step_study.json."""
     rec = json.loads((out / "time_step_study.json").read_text())
-    (out / "time_step_study.md").write_text(markdown(rec))
+    write_text_atomic(out / "time_step_study.md", markdown(rec))
     figure(rec, out / "time_step_study.png")
     return rec

@@ -23,8 +23,7 @@ from typing import Any
 
 import numpy as np
 
-# Table II: (last episode of the band, alpha_p); the last band runs on.
-TABLE_II: tuple[tuple[int | None, float], ...] = ((100, 0.1), (200, 0.05), (300, 0.01), (400, 0.005), (None, 0.001))
+from drake_biped.paper import TABLE_II
 
 
 def learning_rate(episode: int, schedule: Sequence[tuple[int | None, float]] = TABLE_II) -> float:

@@ -1,15 +1,18 @@
-"""Files a walk writes: its record, the Drake diagram as SVG/PNG, a standalone Meshcat HTML recording, the
-walk figure and GIF (`write_walk` writes them all)."""
+"""One walk and every file it writes: its record, the Drake diagram as DOT/SVG/PNG, a standalone Meshcat HTML
+recording, the walk figure and GIF (`run` writes them all; `drake-biped walk` is this module)."""
 
 from __future__ import annotations
 
 import shutil
 import subprocess
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from pydrake.systems.framework import Diagram
+
+from drake_biped.params import EpisodeConfig
 
 
 class GraphvizMissingError(RuntimeError):
@@ -60,11 +63,61 @@ def write_meshcat_html(meshcat, path: Path, x_range: tuple[float, float] | None 
     Path(path).write_text(meshcat.StaticHtml())
 
 
-def write_walk(config, out: Path, animation: bool = True, save_trajectory: bool = False, progress=None):
+@dataclass(frozen=True)
+class WalkSettings:
+    """The episode, and which of the optional files to write."""
+
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    animation: bool = True  # walk.html (Meshcat recording) and walk.gif
+    save_trajectory: bool = False  # trajectory.npz
+
+
+def run(settings: WalkSettings, out: Path, client=None, progress: bool = True):
+    """Walk one episode (in this process: Meshcat records it; `client` is not used) and write its files into
+    `out` (see `write_walk`), with a progress bar in metres. The EpisodeResult."""
+    update, bar = None, None
+    if progress:
+        from tqdm import tqdm
+
+        total = settings.config.sim.distance_m
+        bar = tqdm(total=round(total, 2), desc="walk", unit="m",
+                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} m [{elapsed}<{remaining}{postfix}]")
+
+        def update(t: float, d: float) -> None:
+            bar.n = round(min(max(d, 0.0), total), 2)
+            bar.set_postfix_str(f"t={t:.1f}s", refresh=False)
+            bar.refresh()
+
+    try:
+        return write_walk(settings.config, out, animation=settings.animation,
+                          save_trajectory=settings.save_trajectory, progress=update)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def summary_lines(result) -> list[str]:
+    """What `drake-biped walk` prints: how the walk ended, its gait, its energy, its speed of simulation."""
+    status = f"FELL ({result.fall_reason})" if result.fell else f"ended: {result.termination}"
+    cmt = "n/a" if result.cost_of_transport is None else f"{result.cost_of_transport:.3f}"
+    cmt_kg = "n/a" if result.cost_of_transport_per_kg is None else f"{result.cost_of_transport_per_kg:.3f}"
+    period = "n/a" if result.step_period_s is None else f"{result.step_period_s:.3f} s"
+    length = "n/a" if result.step_length_m is None else f"{result.step_length_m:.3f} m"
+    return [
+        f"{status}: {result.distance_m:.2f} m in {result.duration_s:.2f} s ({result.mean_speed_mps:.3f} m/s), "
+        f"{len(result.steps)} steps, step {period} / {length}",
+        f"positive work {result.total_positive_work_j:.1f} J, C_mt {cmt} (E+/(m g d)), "
+        f"{cmt_kg} J/(kg m) (paper's eq. 1)",
+        f"wall {result.wall_time_s:.1f} s, real-time factor {result.real_time_factor:.2f}",
+    ]
+
+
+def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_trajectory: bool = False,
+               progress=None):
     """Walk one episode of `config` and write into `out`: result.json, diagram.svg/.png (when Graphviz is
     installed; a warning otherwise), walk.png, and with `animation` walk.html (Meshcat recording) and
     walk.gif; trajectory.npz with `save_trajectory`. progress(t, distance) as it walks. The EpisodeResult."""
-    from analysis.figures import walk_animation, walk_figure
+    from drake_biped.analysis.figures import walk_animation, walk_figure
     from drake_biped.diagram import build_diagram
     from drake_biped.episode import run_episode
 

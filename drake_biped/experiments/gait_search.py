@@ -8,6 +8,7 @@ if it scores at least as well as the parent. This is how `params.DEFAULT_CPG`/`D
 Score of a configuration: -9 if it does not walk `distance_m` without a window; otherwise the largest
 fractional C_mt saving among the scored windows that also walk (-0.3 if none walks), plus 0.03 for every
 window that walks. Every generation is appended to `search.jsonl`; a rerun resumes from its last line.
+The children of a generation are scored in parallel on Dask (`executor`).
 """
 
 from __future__ import annotations
@@ -16,11 +17,12 @@ import dataclasses
 import json
 import math
 import random
-from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
 ACCEPTANCE_WINDOWS = ((0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7))
@@ -92,60 +94,73 @@ def _child(args) -> tuple[dict, float, dict]:
     return child.to_dict(), value, detail
 
 
-def run_search(
-    start: EpisodeConfig,
-    out: Path,
-    generations: int = 50,
-    offspring: int = 4,
-    sigma: float = 0.1,
-    seed: int = 0,
-    distance_m: float = 6.0,
-    windows=ACCEPTANCE_WINDOWS,
-    workers: int = 2,
-    progress: bool = True,
-) -> dict[str, Any]:
-    """Evolve from `start`; write `search.jsonl` (one line per generation) and `best_config.json`."""
-    if generations < 1 or offspring < 1 or not sigma > 0 or not distance_m > 0:
-        raise ParameterError(
-            f"generations ({generations!r}) and offspring ({offspring!r}) must be >= 1, "
-            f"sigma ({sigma!r}) and distance_m ({distance_m!r}) > 0"
-        )
+@dataclass(frozen=True)
+class GaitSearchSettings:
+    """Where the search starts and how it steps (module docstring)."""
+
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    generations: int = 50
+    offspring: int = 4
+    sigma: float = 0.1
+    seed: int = 0
+    distance_m: float = 6.0
+    windows: tuple[tuple[float, float], ...] = ACCEPTANCE_WINDOWS
+
+    def __post_init__(self) -> None:
+        if self.generations < 1 or self.offspring < 1 or not self.sigma > 0 or not self.distance_m > 0:
+            raise ParameterError(
+                f"generations ({self.generations!r}) and offspring ({self.offspring!r}) must be >= 1, "
+                f"sigma ({self.sigma!r}) and distance_m ({self.distance_m!r}) > 0"
+            )
+
+
+def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """Evolve from settings.config on `client` (a LocalCluster when None); write `search.jsonl` (one line
+    per generation) and `best_config.json` (use it with --params); return the best and its score."""
+    from drake_biped.experiments.executor import client_or_local, map_ordered
+
+    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     log = out / "search.jsonl"
-    start = start.replace(sim=dataclasses.replace(start.sim, distance_m=distance_m,
-                                                  max_time_s=max(start.sim.max_time_s, 6.0 * distance_m)))
-    windows = [tuple(w) for w in windows]
+    start, seed, sigma = settings.config, settings.seed, settings.sigma
+    start = start.replace(sim=dataclasses.replace(start.sim, distance_m=settings.distance_m,
+                                                  max_time_s=max(start.sim.max_time_s, 6.0 * settings.distance_m)))
+    windows = [tuple(w) for w in settings.windows]
     first = 1
     records = _read_log(log)
-    if records:
-        last = records[-1]
-        parent, parent_score, first = last["parent"], last["parent_score"], last["generation"] + 1
-    else:
-        parent = start.to_dict()
-        parent_score, detail = score(start, windows)
-        _append(log, {"generation": 0, "parent": parent, "parent_score": parent_score, "detail": detail,
-                      "seed": seed, "sigma": sigma, "versions": versions()})
     bar = None
-    if progress:
-        from tqdm import tqdm
+    with client_or_local(client) as c:
+        if records:
+            last = records[-1]
+            parent, parent_score, first = last["parent"], last["parent_score"], last["generation"] + 1
+        else:
+            parent = start.to_dict()
+            parent_score, detail = c.submit(score, start, windows, pure=False).result()
+            _append(log, {"generation": 0, "parent": parent, "parent_score": parent_score, "detail": detail,
+                          "seed": seed, "sigma": sigma, "versions": versions()})
+        if progress:
+            from tqdm import tqdm
 
-        bar = tqdm(total=generations, initial=min(first - 1, generations), desc="search", unit="gen")
-    with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
-        for gen in range(first, generations + 1):
-            jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows) for k in range(offspring)]
-            children = list(pool.map(_child, jobs))
-            best_dict, best_score, best_detail = max(children, key=lambda c: c[1])
-            if best_score >= parent_score:
-                parent, parent_score = best_dict, best_score
-            _append(log, {"generation": gen, "parent": parent, "parent_score": parent_score,
-                          "best_child_score": best_score, "child_scores": [c[1] for c in children],
-                          "best_child_detail": best_detail})
+            bar = tqdm(total=settings.generations, initial=min(first - 1, settings.generations), desc="search",
+                       unit="gen")
+        try:
+            for gen in range(first, settings.generations + 1):
+                jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows)
+                        for k in range(settings.offspring)]
+                children = map_ordered(c, _child, jobs)
+                best_dict, best_score, best_detail = max(children, key=lambda ch: ch[1])
+                if best_score >= parent_score:
+                    parent, parent_score = best_dict, best_score
+                _append(log, {"generation": gen, "parent": parent, "parent_score": parent_score,
+                              "best_child_score": best_score, "child_scores": [ch[1] for ch in children],
+                              "best_child_detail": best_detail})
+                if bar is not None:
+                    bar.update(1)
+                    bar.set_postfix_str(f"score {parent_score:+.3f}")
+        finally:
             if bar is not None:
-                bar.update(1)
-                bar.set_postfix_str(f"score {parent_score:+.3f}")
-    if bar is not None:
-        bar.close()
-    (out / "best_config.json").write_text(json.dumps(parent, indent=2) + "\n")
+                bar.close()
+    write_text_atomic(out / "best_config.json", json.dumps(parent, indent=2) + "\n")
     return {"parent": parent, "score": parent_score}
 
 

@@ -13,11 +13,10 @@ costs the episode it was running: Dask runs that task again elsewhere. A rerun m
 episodes (a trial runs until it holds at least --episodes; one that holds more keeps them all, and its
 evaluation uses the policy it ended with); seed, configuration and learner must match.
 
-Reward (eq. 13, with a fall rule): r = (d / D) / C_mt, where C_mt = E+ / (m g d) is the dimensionless cost
-of transport (as in Table V), d the distance walked (capped at D) and D the episode's target distance
-(10 m). A walk that completes gets 1 / C_mt; a fall is scaled down by the fraction of the distance it
-covered: without that factor a fall after half a metre, having spent little energy, would out-earn a
-complete walk. No distance or no work: r = 0.
+Reward (eq. 13, with a fall rule; `drake_biped.analysis.reward`): r = min(d / D, 1) / C_mt, where C_mt =
+E+ / (m g d) is the dimensionless cost of transport (as in Table V), d the distance walked and D the
+episode's target distance (10 m). A walk that completes gets 1 / C_mt; a fall is scaled down by the fraction
+of the distance it covered. No distance or no work: r = 0.
 
 Sampled times below 0 act as 0 in the episode (the learner updates with the sample itself); t2 <= t1
 means no torque-free period, as in the paper.
@@ -26,29 +25,31 @@ means no torque-free period, as in the paper.
 from __future__ import annotations
 
 import json
-import math
-import os
-import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from drake_biped.garb import TABLE_II, GarbLearner
+from drake_biped.analysis.reward import reward
+from drake_biped.learners.garb import GarbLearner
+from drake_biped.paper import (
+    GARB_BETA,
+    GARB_MEAN_S,
+    GARB_VARIANCE_S2,
+    LEARNING_EPISODES,
+    LEARNING_TRIALS,
+    TABLE_II,
+)
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.records import write_atomic
 from drake_biped.versions import versions
 
+__all__ = ["LearningSettings", "Trial", "best_learned_trial", "make_settings", "reward", "run", "run_learning",
+           "summary_lines"]
+
 RECORD_VERSION = 1
-
-
-def reward(cost_of_transport: float | None, distance_m: float, target_m: float) -> float:
-    """The documented reward (module docstring)."""
-    if cost_of_transport is None or not np.isfinite(cost_of_transport) or cost_of_transport <= 0:
-        return 0.0
-    if distance_m <= 0 or target_m <= 0:
-        return 0.0
-    return min(distance_m / target_m, 1.0) / cost_of_transport
 
 
 def trial_seed(seed: int, trial: int) -> int:
@@ -59,26 +60,6 @@ def trial_seed(seed: int, trial: int) -> int:
 def window_of(sample: np.ndarray) -> TorqueFreeWindow:
     t1, t2 = (max(0.0, min(float(x), 10.0)) for x in sample)
     return TorqueFreeWindow(t1, t2)
-
-
-def write_atomic(path: Path, data: dict) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as f:
-        json.dump(data, f, indent=1, allow_nan=False)
-        f.write("\n")
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def read_json(path: Path, what: str) -> Any:
-    """The JSON in `path`, or ParameterError naming `what` (the option or command that gave the path)."""
-    if not path.is_file():
-        raise ParameterError(f"{what}: no such file: {path}")
-    try:
-        return json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"{what} {path}: not valid JSON ({exc})") from None
 
 
 def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
@@ -201,7 +182,7 @@ def run_learning(
     this call recorded."""
     from distributed import as_completed
 
-    from drake_biped.parallel import episode_task
+    from drake_biped.experiments.executor import episode_task
 
     out.mkdir(parents=True, exist_ok=True)
     (out / "trials").mkdir(exist_ok=True)
@@ -237,7 +218,7 @@ def run_learning(
 
 def evaluate(settings: dict[str, Any], trials: list[Trial], client) -> dict[str, Any]:
     """Table V's measured rows: the gait without a window, and with each trial's final policy mean."""
-    from drake_biped.parallel import episode_task
+    from drake_biped.experiments.executor import episode_task
 
     base = EpisodeConfig.from_dict(settings["config"])
     configs = [base.to_dict()] + [base.replace(window=window_of(t.learner.mean)).to_dict() for t in trials]
@@ -268,99 +249,68 @@ def learning_record(settings: dict[str, Any], trials: list[Trial], evaluation: d
     }
 
 
-class SessionLog:
-    """OUT/run.json: one entry per session of a run (a first run and each resume): when, on what, how many
-    episodes in how long. Rewritten at most every `every_s` seconds while running, so a session that is
-    killed keeps its numbers. Wall times live here, not in learning.json, which a resume reproduces."""
+@dataclass(frozen=True)
+class LearningSettings:
+    """A learning run: `trials` independent GARB learners of `episodes` episodes each on `config`'s gait,
+    the policy starting at `mean` with `variance` per time (the paper's settings by default)."""
 
-    def __init__(self, path: Path, workers: int | None, scheduler: str | None, every_s: float = 10.0):
-        self.path = path
-        self.sessions: list[dict[str, Any]] = []
-        if path.is_file():
-            try:
-                self.sessions = list(json.loads(path.read_text()).get("sessions", []))
-            except (json.JSONDecodeError, AttributeError):
-                pass  # an unreadable log starts afresh; learning.json and the trials are not affected
-        self.t0 = time.perf_counter()
-        self.every_s = every_s
-        self._last = -math.inf
-        self.current = {"started": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "workers": workers,
-                        "scheduler": scheduler, "episodes": 0, "learning_wall_s": 0.0, "wall_s": 0.0,
-                        "episodes_per_min": None, "finished": False}
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    trials: int = LEARNING_TRIALS
+    episodes: int = LEARNING_EPISODES
+    seed: int = 0
+    mean: tuple[float, float] = GARB_MEAN_S
+    variance: float = GARB_VARIANCE_S2
+    beta: float = GARB_BETA
+    schedule: tuple[tuple[int | None, float], ...] = TABLE_II
 
-    def update(self, episodes: int, learning: bool = True, finished: bool = False, force: bool = False) -> None:
-        now = time.perf_counter() - self.t0
-        self.current["episodes"] = episodes
-        if learning:
-            self.current["learning_wall_s"] = now
-            self.current["episodes_per_min"] = 60.0 * episodes / now if episodes and now > 0 else None
-        self.current["wall_s"] = now
-        self.current["finished"] = finished
-        if force or finished or now - self._last >= self.every_s:
-            self._last = now
-            done = [*self.sessions, self.current]
-            episodes_all = sum(s["episodes"] for s in done)
-            wall_all = sum(s["learning_wall_s"] for s in done)
-            write_atomic(self.path, {
-                "sessions": done, "episodes": episodes_all, "learning_wall_s": wall_all,
-                "episodes_per_min": 60.0 * episodes_all / wall_all if episodes_all and wall_all > 0 else None})
+    def record(self) -> dict[str, Any]:
+        """The settings as every trial record and learning.json hold them (`make_settings`)."""
+        return make_settings(self.config, self.trials, self.episodes, self.seed, mean=tuple(self.mean),
+                             variance=self.variance, beta=self.beta, schedule=self.schedule)
 
 
-class RunProgress:
-    """A progress bar (when `bar` is set) and the run log OUT/run.json (`SessionLog`) of a resumable run;
-    called as progress(done, total, latest_mean_reward=None) by the run as it goes."""
+def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, progress: bool = True,
+        workers: int | None = None, scheduler: str | None = None) -> dict[str, Any]:
+    """Run or resume the learning on `client` (a LocalCluster when None), evaluate the final policies, and
+    write learning.json, run.json, fig4_reward.png, fig5_cmt.png, fig6_times.png and table_v.md into `out`.
+    `settings`: a LearningSettings, or the record dictionary of one. workers/scheduler: what run.json
+    records of the cluster. Returns the learning record."""
+    from drake_biped.analysis.figures import learning_figures
+    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import RunProgress
 
-    def __init__(self, out: Path, workers: int | None, scheduler: str | None, desc: str, unit: str,
-                 bar: bool = True):
-        out.mkdir(parents=True, exist_ok=True)
-        self.log = SessionLog(out / "run.json", workers, scheduler)
-        self.bar = None
-        if bar:
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=0, desc=desc, unit=unit)
-        self.first: int | None = None
-        self.done = 0
-
-    def __call__(self, done: int, total: int, latest: float | None = None) -> None:
-        if self.first is None:
-            self.first = done
-        self.done = done
-        self.log.update(done - self.first)
-        if self.bar is not None:
-            self.bar.total = total
-            self.bar.n = done
-            if latest is not None:
-                self.bar.set_postfix_str(f"latest mean reward {latest:.3f}", refresh=False)
-            self.bar.refresh()
-
-    @property
-    def new(self) -> int:
-        """What this session computed."""
-        return 0 if self.first is None else self.done - self.first
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
-def learn(out: Path, settings: dict[str, Any], workers: int | None = None, scheduler: str | None = None,
-          progress: bool = True) -> dict[str, Any]:
-    """Run or resume the learning, evaluate, write learning.json, run.json, the figures and Table V."""
-    from analysis.figures import learning_figures
-    from drake_biped.parallel import dask_client
-
+    out = Path(out)
+    record_settings = settings.record() if isinstance(settings, LearningSettings) else settings
     versions()  # the code version this process runs, recorded now (it is cached), not at the run's end
     report = RunProgress(out, workers, scheduler, "learning", "episode", bar=progress)
     try:
-        with dask_client(workers=workers, scheduler=scheduler) as client:
-            trials, new = run_learning(out, settings, client, report)
+        with client_or_local(client) as c:
+            trials, new = run_learning(out, record_settings, c, report)
             report.log.update(new, force=True)
-            evaluation = evaluate(settings, trials, client)
+            evaluation = evaluate(record_settings, trials, c)
     finally:
         report.close()
-    record = learning_record(settings, trials, evaluation)
+    record = learning_record(record_settings, trials, evaluation)
     write_atomic(out / "learning.json", record)
     report.log.update(new, learning=False, finished=True)
     learning_figures(record, out)
     return record
+
+
+def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
+    """What `drake-biped learn` prints after a run: Table V, the reduction, the run's speed."""
+    ev = record["evaluation"]
+    lines = [(out / "table_v.md").read_text()]
+    base = ev["no_window"]["cost_of_transport"]
+    if ev.get("reduction") is not None:
+        lines.append(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
+                     f"{ev['learned_mean_cost_of_transport']:.3f}: {100 * ev['reduction']:.1f} % lower")
+    run_log = json.loads((out / "run.json").read_text())
+    this = run_log["sessions"][-1]
+    if this["episodes_per_min"]:
+        lines.append(f"{this['episodes']} episodes in {this['learning_wall_s']:.0f} s "
+                     f"({this['episodes_per_min']:.1f} episodes/min); the whole run so far: {run_log['episodes']} "
+                     f"episodes, {run_log['learning_wall_s'] / 60:.1f} min of learning over "
+                     f"{len(run_log['sessions'])} session(s)")
+    lines.append(f"wrote {out}/learning.json, fig4_reward.png, fig5_cmt.png, fig6_times.png, table_v.md")
+    return lines

@@ -18,41 +18,31 @@ killed while writing) is ignored and its point rerun.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import hashlib
+import io
 import itertools
 import json
 import math
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
+from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError
+from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-# Table IV of the paper: the grid search's ranges of the CPG parameters.
-TABLE_IV: dict[str, tuple[float, float]] = {
-    "alpha": (-2.0, 2.0),
-    "u_a": (0.0, 3.0),
-    "u_eta": (-1.0, 1.0),
-    "u_r": (0.0, 3.0),
-    "kappa": (0.0, 2.0),
-}
+__all__ = ["Axis", "GridSettings", "load_spec", "parse_spec", "run", "run_grid", "summary_lines", "table_iv_axes"]
+
+TABLE_IV = PAPER_TABLE_IV  # the grid search's ranges of the CPG parameters
 # The initiation's ranges (the paper searched it too but prints no range): from standing still with the
 # legs together to twice the paper's 7.6 deg and 0.175 m/s.
 INITIATION_RANGES: dict[str, tuple[float, float]] = {
     "hip_angle": (0.0, 2 * math.radians(7.6)),
     "speed": (0.0, 2 * 0.175),
-}
-SHORT_NAMES = {
-    "alpha": "cpg.alpha",
-    "u_a": "cpg.u_a",
-    "u_eta": "cpg.u_eta",
-    "u_r": "cpg.u_r",
-    "kappa": "cpg.kappa",
-    "hip_angle": "initial.hip_angle_rad",
-    "speed": "initial.speed_mps",
 }
 _SECTIONS = ("cpg", "gait", "initial", "window", "ground", "sim")
 RESULT_FIELDS = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps",
@@ -75,7 +65,8 @@ class Axis:
 
 
 def field_name(name: str) -> str:
-    """The dotted EpisodeConfig field of an axis name (short or dotted); ParameterError if unknown."""
+    """The dotted EpisodeConfig field of an axis name (short or dotted, as `EpisodeConfig.override` takes
+    them); ParameterError if it is not a numeric field of a section the grid may vary."""
     dotted = SHORT_NAMES.get(name, name)
     section, _, attr = dotted.partition(".")
     base = EpisodeConfig()
@@ -134,10 +125,14 @@ def parse_spec(spec: Any, source: str = "grid spec") -> list[Axis]:
     return axes
 
 
-def load_spec(path: Path) -> list[Axis]:
-    """Axes from a YAML (or JSON) spec file; see `parse_spec`."""
+def load_spec(path: Path | str) -> list[Axis]:
+    """Axes from a YAML (or JSON) spec file, or a shipped spec by name (`slope_2deg`, ...); see
+    `parse_spec`."""
     import yaml
 
+    from drake_biped.resources import grid_spec_names, grid_spec_path
+
+    path = grid_spec_path(path) if str(path) in grid_spec_names() else Path(path)
     if not path.is_file():
         raise ParameterError(f"--spec: no such file: {path}")
     try:
@@ -200,7 +195,7 @@ def run_grid(out: Path, base: EpisodeConfig, axes: list[Axis], client,
     best_params.json and the slice figure; return the grid record."""
     from distributed import as_completed
 
-    from drake_biped.parallel import episode_task
+    from drake_biped.experiments.executor import episode_task
 
     code = versions()
     out.mkdir(parents=True, exist_ok=True)
@@ -248,19 +243,19 @@ def run_grid(out: Path, base: EpisodeConfig, axes: list[Axis], client,
 
 def write_outputs(out: Path, base: EpisodeConfig, axes: list[Axis], points: list[dict[str, float]],
                   configs: list[dict[str, Any]], rows: list[dict[str, Any]], code: dict[str, Any]) -> dict[str, Any]:
-    from analysis.figures import grid_slices_figure
-    from drake_biped.learning import write_atomic
+    from drake_biped.analysis.figures import grid_slices_figure
 
     best = None
     for i, row in enumerate(rows):
         if better(row, rows[best] if best is not None else None):
             best = i
     names = [a.name for a in axes]
-    with open(out / "grid.csv", "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([*names, *RESULT_FIELDS])
-        for p, row in zip(points, rows):
-            writer.writerow([p[n] for n in names] + [row[k] for k in RESULT_FIELDS])
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow([*names, *RESULT_FIELDS])
+    for p, row in zip(points, rows):
+        writer.writerow([p[n] for n in names] + [row[k] for k in RESULT_FIELDS])
+    write_text_atomic(out / "grid.csv", text.getvalue())
     best_config = configs[best]
     write_atomic(out / "best_params.json", best_config)
     walked = [r for r in rows if not r["fell"] and r["distance_m"] >= base.sim.distance_m - 1e-6]
@@ -275,3 +270,42 @@ def write_outputs(out: Path, base: EpisodeConfig, axes: list[Axis], points: list
     write_atomic(out / "grid.json", record)
     grid_slices_figure(axes, points, rows, points[best], out / "grid_slices.png", base.sim.distance_m)
     return record
+
+
+@dataclass(frozen=True)
+class GridSettings:
+    """A grid: the base configuration and the axes (Table IV's ranges and the initiation's by default)."""
+
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    axes: tuple[Axis, ...] = field(default_factory=lambda: tuple(table_iv_axes(2)))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"config": self.config.to_dict(), "axes": [dataclasses.asdict(a) for a in self.axes]}
+
+
+def run(settings: GridSettings, out: Path, client=None, progress: bool = True,
+        workers: int | None = None, scheduler: str | None = None) -> dict[str, Any]:
+    """Run or finish the grid on `client` (a LocalCluster when None), with a progress bar and the run log
+    OUT/run.json; write points.jsonl, grid.csv, grid.json, grid_slices.png, best_params.json. The record."""
+    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import RunProgress
+
+    out = Path(out)
+    report = RunProgress(out, workers, scheduler, "grid", "point", bar=progress)
+    try:
+        with client_or_local(client) as c:
+            record = run_grid(out, settings.config, list(settings.axes), c, report)
+    finally:
+        report.close()
+    report.log.update(report.new, finished=True)
+    return record
+
+
+def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
+    """The grid in two lines: how many points walk, and the best."""
+    best = record["best"]
+    cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
+    distance = record["base_config"]["sim"]["distance_m"]
+    return [f"{record['walked_the_distance']}/{record['points']} points walk {distance:g} m; best "
+            f"{', '.join(f'{k}={v:.4g}' for k, v in best['point'].items())}: {best['distance_m']:.2f} m, C_mt {cmt}",
+            f"wrote {out}/grid.csv, grid.json, grid_slices.png, best_params.json (use --params)"]

@@ -1,0 +1,63 @@
+"""The expected reward GARB climbs, from a measured window map (`analysis.landscape`): landscape.json and
+landscape.png, for the policy variances asked. Reads records only; simulates nothing."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from drake_biped.analysis.landscape import WindowRewards, landscape
+from drake_biped.params import ParameterError
+from drake_biped.records import write_atomic
+from drake_biped.versions import versions
+
+__all__ = ["LandscapeSettings", "run", "summary_lines"]
+
+
+@dataclass(frozen=True)
+class LandscapeSettings:
+    """The window map (a window-map folder or its window_map.json), the variances (s^2), the policy
+    starts to evaluate, and the Monte Carlo samples per mean with their seed."""
+
+    window_map: str
+    variances: tuple[float, ...] = (0.04, 0.01, 0.0025)
+    starts: tuple[tuple[float, float], ...] = ((0.5, 0.5),)
+    samples: int = 2000
+    seed: int = 0
+
+    def path(self) -> Path:
+        source = Path(self.window_map)
+        return source / "window_map.json" if source.is_dir() else source
+
+
+def run(settings: LandscapeSettings, out: Path | None = None, client=None, progress: bool = True) -> dict[str, Any]:
+    """Write landscape.json and landscape.png into `out` (default: the window map's folder); the record."""
+    from drake_biped.analysis.figures import landscape_figure
+
+    path = settings.path()
+    if not path.is_file():
+        raise ParameterError(f"landscape: no window map at {settings.window_map} (run drake-biped window-map first)")
+    try:
+        rewards = WindowRewards.from_window_map(json.loads(path.read_text()))
+    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+        raise ParameterError(f"landscape: {path} is not a window map ({exc})") from None
+    record = landscape(rewards, list(settings.variances), samples=settings.samples, seed=settings.seed,
+                       starts=[tuple(s) for s in settings.starts])
+    record.update(window_map=str(path), samples=settings.samples, seed=settings.seed, versions=versions())
+    out = Path(out) if out is not None else path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "landscape.json", record)
+    landscape_figure(record, out / "landscape.png")
+    return record
+
+
+def summary_lines(record: dict[str, Any]) -> list[str]:
+    lines = [f"no window: reward {record['no_window_reward']:.3f}"]
+    for cell in record["variances"]:
+        s = cell["starts"][0]
+        lines.append(f"variance {cell['variance']:g}: best policy mean ({cell['best_mean'][0]:.3f}, "
+                     f"{cell['best_mean'][1]:.3f}) expected reward {100 * cell['best_gain']:+.1f} % vs no window; "
+                     f"at the start {tuple(s['mean'])} {100 * s['gain']:+.1f} %")
+    return lines

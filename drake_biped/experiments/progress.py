@@ -1,0 +1,89 @@
+"""Progress of a resumable run: a tqdm bar and the run log OUT/run.json (every session's count and wall time)."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+from drake_biped.records import write_atomic
+
+__all__ = ["RunProgress", "SessionLog"]
+
+
+class SessionLog:
+    """OUT/run.json: one entry per session of a run (a first run and each resume): when, on what, how many
+    episodes in how long. Rewritten at most every `every_s` seconds while running, so a session that is
+    killed keeps its numbers. Wall times live here, not in learning.json, which a resume reproduces."""
+
+    def __init__(self, path: Path, workers: int | None, scheduler: str | None, every_s: float = 10.0):
+        self.path = path
+        self.sessions: list[dict[str, Any]] = []
+        if path.is_file():
+            try:
+                self.sessions = list(json.loads(path.read_text()).get("sessions", []))
+            except (json.JSONDecodeError, AttributeError):
+                pass  # an unreadable log starts afresh; learning.json and the trials are not affected
+        self.t0 = time.perf_counter()
+        self.every_s = every_s
+        self._last = -math.inf
+        self.current = {"started": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "workers": workers,
+                        "scheduler": scheduler, "episodes": 0, "learning_wall_s": 0.0, "wall_s": 0.0,
+                        "episodes_per_min": None, "finished": False}
+
+    def update(self, episodes: int, learning: bool = True, finished: bool = False, force: bool = False) -> None:
+        now = time.perf_counter() - self.t0
+        self.current["episodes"] = episodes
+        if learning:
+            self.current["learning_wall_s"] = now
+            self.current["episodes_per_min"] = 60.0 * episodes / now if episodes and now > 0 else None
+        self.current["wall_s"] = now
+        self.current["finished"] = finished
+        if force or finished or now - self._last >= self.every_s:
+            self._last = now
+            done = [*self.sessions, self.current]
+            episodes_all = sum(s["episodes"] for s in done)
+            wall_all = sum(s["learning_wall_s"] for s in done)
+            write_atomic(self.path, {
+                "sessions": done, "episodes": episodes_all, "learning_wall_s": wall_all,
+                "episodes_per_min": 60.0 * episodes_all / wall_all if episodes_all and wall_all > 0 else None})
+
+
+class RunProgress:
+    """A progress bar (when `bar` is set) and the run log OUT/run.json (`SessionLog`) of a resumable run;
+    called as progress(done, total, latest_mean_reward=None) by the run as it goes."""
+
+    def __init__(self, out: Path, workers: int | None, scheduler: str | None, desc: str, unit: str,
+                 bar: bool = True):
+        out.mkdir(parents=True, exist_ok=True)
+        self.log = SessionLog(out / "run.json", workers, scheduler)
+        self.bar = None
+        if bar:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=0, desc=desc, unit=unit)
+        self.first: int | None = None
+        self.done = 0
+
+    def __call__(self, done: int, total: int, latest: float | None = None) -> None:
+        if self.first is None:
+            self.first = done
+        self.done = done
+        self.log.update(done - self.first)
+        if self.bar is not None:
+            self.bar.total = total
+            self.bar.n = done
+            if latest is not None:
+                self.bar.set_postfix_str(f"latest mean reward {latest:.3f}", refresh=False)
+            self.bar.refresh()
+
+    @property
+    def new(self) -> int:
+        """What this session computed."""
+        return 0 if self.first is None else self.done - self.first
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

@@ -1,0 +1,128 @@
+"""Map a grid of torque-free windows (t1, t2) for one gait: which walk the distance, and their C_mt
+against the same gait with no window. Episodes run on Dask (`executor`); each worker receives an
+EpisodeConfig (numbers only) and builds its own diagram.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.params import EpisodeConfig, TorqueFreeWindow
+from drake_biped.records import write_text_atomic
+from drake_biped.versions import versions
+
+__all__ = ["WindowMapSettings", "evaluate_windows", "run", "summary_lines", "window_grid"]
+
+
+@dataclass(frozen=True)
+class WindowMapSettings:
+    """The gait and the grid: t1 from 0 to t1_max, t2 from t1 + min_length to t2_max, both in steps."""
+
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    t1_max_s: float = 0.6
+    t2_max_s: float = 0.9
+    t1_step_s: float = 0.1
+    t2_step_s: float = 0.1
+    min_length_s: float = 0.1
+
+    def windows(self) -> list[tuple[float, float]]:
+        return window_grid(self.t1_max_s, self.t2_max_s, self.t1_step_s, self.t2_step_s, self.min_length_s)
+
+
+def window_grid(t1_max: float = 0.6, t2_max: float = 0.9, t1_step: float = 0.1, t2_step: float = 0.1,
+                min_length: float = 0.1) -> list[tuple[float, float]]:
+    """(t1, t2) pairs: t1 from 0 to t1_max, t2 from t1 + min_length to t2_max, rounded to 1e-6 s."""
+    out = []
+    for t1 in np.arange(0.0, t1_max + 1e-9, t1_step):
+        for t2 in np.arange(t1 + min_length, t2_max + 1e-9, t2_step):
+            out.append((round(float(t1), 6), round(float(t2), 6)))
+    return out
+
+
+def window_row(config: dict[str, Any]) -> dict[str, Any]:
+    """One episode of an EpisodeConfig dictionary, summarised as a row of the map (runs on a worker)."""
+    from drake_biped.episode import run_episode
+
+    c = EpisodeConfig.from_dict(config)
+    r = run_episode(c)
+    hip = sum(v for k, v in r.positive_work_j.items() if k.endswith("hip"))
+    return {
+        "t1": c.window.start_s,
+        "t2": c.window.end_s,
+        "walked": (not r.fell) and r.distance_m >= c.sim.distance_m - 1e-6,
+        "distance_m": r.distance_m,
+        "fall_reason": r.fall_reason,
+        "cost_of_transport": r.cost_of_transport,
+        "positive_work_j": r.total_positive_work_j,
+        "hip_positive_work_j": hip,
+        "step_period_s": r.step_period_s,
+        "step_length_m": r.step_length_m,
+        "mean_speed_mps": r.mean_speed_mps,
+    }
+
+
+def evaluate_windows(config: EpisodeConfig, windows: list[tuple[float, float]], client,
+                     progress: bool = True) -> tuple[dict, list[dict]]:
+    """The no-window baseline and one row per window, on the Dask `client`."""
+    from drake_biped.experiments.executor import map_ordered
+
+    configs = [config.replace(window=TorqueFreeWindow(0.0, 0.0))]
+    configs += [config.replace(window=TorqueFreeWindow(t1, t2)) for t1, t2 in windows]
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(configs), desc="windows", unit="episode")
+    try:
+        rows = map_ordered(client, window_row, [c.to_dict() for c in configs],
+                           progress=(lambda done, _: bar.update(1)) if bar is not None else None)
+    finally:
+        if bar is not None:
+            bar.close()
+    baseline, rows = rows[0], rows[1:]
+    for r in rows:
+        ok = r["walked"] and baseline["walked"] and r["cost_of_transport"] and baseline["cost_of_transport"]
+        r["cmt_change"] = (r["cost_of_transport"] / baseline["cost_of_transport"] - 1.0) if ok else None
+    return baseline, rows
+
+
+def run(settings: WindowMapSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """Evaluate the grid on `client` (a LocalCluster when None); write window_map.json, window_map.csv and
+    window_map.png into `out`; return the record."""
+    from drake_biped.analysis.figures import window_map_figure
+    from drake_biped.experiments.executor import client_or_local
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    config = settings.config
+    with client_or_local(client) as c:
+        baseline, rows = evaluate_windows(config, settings.windows(), c, progress)
+    record = {"config": config.to_dict(), "baseline": baseline, "windows": rows, "versions": versions()}
+    write_text_atomic(out / "window_map.json", json.dumps(record, indent=2) + "\n")
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=list(rows[0].keys()))
+    writer.writeheader()
+    writer.writerows(rows)
+    write_text_atomic(out / "window_map.csv", text.getvalue())
+    window_map_figure(rows, baseline["cost_of_transport"] if baseline["walked"] else None, out / "window_map.png")
+    return record
+
+
+def summary_lines(record: dict[str, Any]) -> list[str]:
+    """The map in three lines: the baseline, how many windows walk, the cheapest."""
+    baseline, rows = record["baseline"], record["windows"]
+    walked = [r for r in rows if r["walked"]]
+    best = min(walked, key=lambda r: r["cost_of_transport"], default=None)
+    lines = [f"no window: walked={baseline['walked']} C_mt={baseline['cost_of_transport']}",
+             f"{len(walked)}/{len(rows)} windows walk {record['config']['sim']['distance_m']:g} m"]
+    if best is not None:
+        lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
+                     f"({100 * (best['cmt_change'] or 0):+.1f}% vs no window)")
+    return lines

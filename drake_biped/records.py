@@ -1,0 +1,39 @@
+"""Result files: atomic JSON writes (nothing half-written survives a kill) and JSON reads that name the file."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from drake_biped.params import ParameterError
+
+__all__ = ["read_json", "write_atomic", "write_text_atomic"]
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write `text` to `path` through a temporary file and a rename: the file is whole or absent."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def write_atomic(path: Path, data: Any) -> None:
+    """`data` as JSON (NaN refused), written atomically."""
+    write_text_atomic(path, json.dumps(data, indent=1, allow_nan=False) + "\n")
+
+
+def read_json(path: Path, what: str) -> Any:
+    """The JSON in `path`, or ParameterError naming `what` (the option or command that gave the path)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"{what}: no such file: {path}")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"{what} {path}: not valid JSON ({exc})") from None

@@ -1,0 +1,69 @@
+"""Data shipped inside the installed package: the robot model, the named gaits and the grid specs.
+
+Everything is found through the package itself (`importlib.resources`), never through a path relative to
+the source tree, so an installed wheel, an editable checkout and a Dask worker on another machine see the
+same files. The model is loaded by `package://drake_biped/biped.urdf` once `model_package_xml()` is added to
+Drake's PackageMap.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from drake_biped.params import EpisodeConfig, ParameterError
+
+__all__ = ["gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml"]
+
+
+def _package_path(package: str, *parts: str) -> Path:
+    # The package is installed as plain files (a wheel or an editable checkout; pydrake cannot run from a
+    # zip), so its resources are files on disk.
+    return Path(str(resources.files(package).joinpath(*parts)))
+
+
+def model_package_xml() -> Path:
+    """The `package.xml` of the `drake_biped` model package (biped.urdf beside it)."""
+    return _package_path("drake_biped.models", "package.xml")
+
+
+def gait_names() -> list[str]:
+    """Names of the shipped gaits (`--params NAME`): parameter files in drake_biped/gaits/."""
+    return sorted(p.stem for p in _package_path("drake_biped", "gaits").glob("*.json"))
+
+
+def grid_spec_names() -> list[str]:
+    """Names of the shipped grid specs (`--spec NAME`): YAML files in drake_biped/grids/."""
+    return sorted(p.stem for p in _package_path("drake_biped", "grids").glob("*.yaml"))
+
+
+def _named_or_path(value: str | Path, folder: str, suffix: str, names: list[str], what: str) -> Path:
+    text = str(value)
+    if text in names:
+        return _package_path("drake_biped", folder, text + suffix)
+    path = Path(value)
+    if path.is_file():
+        return path
+    raise ParameterError(f"{what} {text!r}: neither a file nor a shipped name (one of {names})")
+
+
+def gait_path(value: str | Path) -> Path:
+    """A shipped gait by name (`climbing`, `climbing_2deg`, ...) or a parameter file by path."""
+    return _named_or_path(value, "gaits", ".json", gait_names(), "--params")
+
+
+def grid_spec_path(value: str | Path) -> Path:
+    """A shipped grid spec by name (`slope_2deg`, ...) or a spec file by path."""
+    return _named_or_path(value, "grids", ".yaml", grid_spec_names(), "--spec")
+
+
+def load_gait(value: str | Path) -> EpisodeConfig:
+    """The EpisodeConfig of a shipped gait (by name) or of a parameter file: EpisodeConfig fields as JSON,
+    or a result record (a walk's result.json, a grid's best_params.json), whose "config" is used."""
+    from drake_biped.records import read_json
+
+    path = gait_path(value)
+    data = read_json(path, "--params")
+    if isinstance(data, dict) and "config" in data:
+        data = data["config"]
+    return EpisodeConfig.from_dict(data)
