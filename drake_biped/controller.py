@@ -10,8 +10,9 @@ with DeclareStateOutputPort, so the plant reads them at its own rate without cal
 
 Input port:  "plant_state" (18): MultibodyPlant state q (9), v (9).
 Output ports: "actuation" (6): joint torques (N*m), JOINT_NAMES order, applied by the plant.
-              "controller_state" (N_STATE): phase, roles, step bookkeeping, work integrals, fall flag.
-Discrete groups: actuation (6), controller state (N_STATE), touchdowns (capacity x TOUCHDOWN_FIELDS).
+              "controller_state" (CONTROLLER_STATE): phase, roles, step bookkeeping, work integrals, fall flag.
+Discrete groups: actuation (6), controller state (CONTROLLER_STATE), touchdowns (capacity x TOUCHDOWN).
+Both layouts are declared once below; outside the update, read them by name (`CONTROLLER_STATE.view`).
 
 Timing: the plant's output ports are sampled (Drake's default for a discrete plant), so the state the
 update at context time t reads is the plant state at t + h, h the plant time step, and the torques it
@@ -30,32 +31,58 @@ from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
 from drake_biped import cpg, gait
 from drake_biped.kinematics import center_of_mass_from_legs, leg_points
+from drake_biped.layout import Field, VectorLayout
+from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
 from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
 
-# Layout of the "controller_state" discrete group.
-GAMMA = 0  # CPG phase (rad)
-STANCE_RIGHT = 1  # 1.0 when the right leg is the stance leg
-STEP_START = 2  # T_n, time of the last touchdown (s)
-LIFTOFF_ANGLE = 3  # swing thigh world angle at T_n (rad)
-STEP_COUNT = 4  # touchdowns so far
-INTEGRAL = 5  # hip PID integrator (rad*s)
-GATE = 6  # 1.0 while the swing hip is torque-free
-FALL = 7  # fall code, see FALL_REASONS
-COM_X = 8  # whole-body centre of mass x at the last update (m)
-TARGET_X = 9  # the episode ends when COM_X reaches this (m)
-DONE = 10  # 1.0 once the distance is walked
-STATE_TIME = 11  # time of the plant state read by the last update (s)
-Q_PREV = 12  # 6 joint angles at the previous update
-TAU = 18  # 6 torques held since the previous update (N*m), a copy of the actuation group
-POSITIVE_WORK = 24  # 6 per-joint integrals of max(tau * omega, 0) dt (J)
-SIGNED_WORK = 30  # 6 per-joint integrals of tau * omega dt (J)
-PREV_CLEARANCE = 36  # the swing foot's clearance at the previous update (m), to place a touchdown in time
-N_STATE = 37
+# The "controller_state" discrete group, declared once; the update below uses the offsets generated here.
+CONTROLLER_STATE = VectorLayout("controller_state", (
+    Field("cpg_phase", 1, "CPG phase gamma (rad)"),
+    Field("stance_right", 1, "1.0 when the right leg is the stance leg"),
+    Field("step_start_s", 1, "T_n, context time of the last touchdown update (s)"),
+    Field("liftoff_angle_rad", 1, "swing thigh world angle at T_n (rad)"),
+    Field("step_count", 1, "touchdowns so far"),
+    Field("hip_integral", 1, "swing-hip PID integrator (rad*s)"),
+    Field("torque_free", 1, "1.0 while the swing hip is torque-free"),
+    Field("fall_code", 1, "why the episode fell, a key of FALL_REASONS (0: it did not)"),
+    Field("com_x_m", 1, "whole-body centre of mass x at the last update (m)"),
+    Field("target_x_m", 1, "the episode ends when com_x_m reaches this (m)"),
+    Field("done", 1, "1.0 once the distance is walked"),
+    Field("state_time_s", 1, "time of the plant state read by the last update (s)"),
+    Field("previous_joint_angles_rad", 6, "joint angles at the previous update, JOINT_NAMES order (rad)"),
+    Field("torques_nm", 6, "torques held since the previous update, a copy of the actuation group (N*m)"),
+    Field("positive_work_j", 6, "per-joint integrals of max(tau * omega, 0) dt (J)"),
+    Field("signed_work_j", 6, "per-joint integrals of tau * omega dt (J)"),
+    Field("previous_clearance_m", 1, "the swing foot's clearance at the previous update (m)"),
+))
+N_STATE = CONTROLLER_STATE.size
+_o = CONTROLLER_STATE.offset
+GAMMA, STANCE_RIGHT, STEP_START, LIFTOFF_ANGLE = _o("cpg_phase"), _o("stance_right"), _o("step_start_s"), \
+    _o("liftoff_angle_rad")
+STEP_COUNT, INTEGRAL, GATE, FALL = _o("step_count"), _o("hip_integral"), _o("torque_free"), _o("fall_code")
+COM_X, TARGET_X, DONE, STATE_TIME = _o("com_x_m"), _o("target_x_m"), _o("done"), _o("state_time_s")
+Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
+POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_work_j"), _o("previous_clearance_m")
+del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
-TOUCHDOWN_FIELDS = ("time_s", "hip_angle_rad", "hip_rate_radps", "stance_right", "com_x_m")
-_TD = len(TOUCHDOWN_FIELDS)
+TOUCHDOWN = VectorLayout("touchdown", (
+    Field("time_s", 1, "when the swing foot's clearance crossed the touchdown height (s)"),
+    Field("hip_angle_rad", 1, "section state: new stance thigh minus new swing thigh (rad)"),
+    Field("hip_rate_radps", 1, "its rate (rad/s)"),
+    Field("stance_right", 1, "1.0 when the new stance leg is the right one"),
+    Field("com_x_m", 1, "centre of mass x (m)"),
+))
+TOUCHDOWN_FIELDS = TOUCHDOWN.names
+_TD = TOUCHDOWN.size
 MAX_TOUCHDOWNS = 4096
+
+# Indices of the legs' joints: in the plant's positions and velocities (the planar base's 3 come first) and
+# in the actuation and torque vectors; a leg's knee and ankle follow its hip.
+Q_HIP = {leg: 3 + joint_index(leg, "hip") for leg in LEGS}
+KNEE, ANKLE = JOINTS_OF_A_LEG.index("knee"), JOINTS_OF_A_LEG.index("ankle")
+# (stance hip, swing hip) position indices, by "the right leg is the stance leg"
+_LEG_Q = {True: (Q_HIP["right"], Q_HIP["left"]), False: (Q_HIP["left"], Q_HIP["right"])}
 
 FALL_REASONS = {
     0: "",
@@ -124,6 +151,18 @@ class CpgWalkingController(LeafSystem):
         self._fall_height = config.sim.fall_hip_height_m
         self._fall_pitch = config.sim.fall_pitch_rad
 
+    def get_input_port_plant_state(self):
+        """The plant state q (9), v (9) this controller reads."""
+        return self._plant_state
+
+    def get_output_port_actuation(self):
+        """The six joint torques (N*m, JOINT_NAMES order)."""
+        return self.GetOutputPort("actuation")
+
+    def get_output_port_controller_state(self):
+        """The controller state (CONTROLLER_STATE)."""
+        return self.GetOutputPort("controller_state")
+
     @property
     def state_group(self) -> int:
         return int(self._state_group)
@@ -148,6 +187,10 @@ class CpgWalkingController(LeafSystem):
             s.SetAtIndex(STANCE_RIGHT, 1.0 if stance_right else 0.0)
         if liftoff_angle is not None:
             s.SetAtIndex(LIFTOFF_ANGLE, liftoff_angle)
+
+    def state(self, context):
+        """The controller state of `context`, by name (CONTROLLER_STATE.view)."""
+        return CONTROLLER_STATE.view(context.get_discrete_state(self._state_group).value())
 
     def touchdowns(self, context) -> np.ndarray:
         """The recorded touchdowns, one row each (columns: TOUCHDOWN_FIELDS)."""
@@ -184,7 +227,7 @@ class CpgWalkingController(LeafSystem):
         left = leg_points(px, pz, pitch, q[3], q[4], q[5])
         right = leg_points(px, pz, pitch, q[6], q[7], q[8])
         stance_right = s[STANCE_RIGHT] > 0.5
-        st_i, sw_i = (6, 3) if stance_right else (3, 6)
+        st_i, sw_i = _LEG_Q[stance_right]
         stance, swing = (right, left) if stance_right else (left, right)
         com_x = center_of_mass_from_legs(px, pz, pitch, left, right)[0]
         s[COM_X] = com_x
@@ -226,7 +269,7 @@ class CpgWalkingController(LeafSystem):
             time_in_step = 0.0
 
         # CPG (eq. 2-3) and the swing reference.
-        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + 2], self._dt)
+        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + ANKLE], self._dt)
         s[GAMMA] = gamma
         zeta = cpg.output(self._cpg, gamma)
         target = gait.placement_target(g, self._amplitude, px - stance.ankle_x, v[0])
@@ -248,15 +291,15 @@ class CpgWalkingController(LeafSystem):
         s[GATE] = 1.0 if gated else 0.0
         tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
 
-        a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3
+        a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
         s[a_sw] = tau_swing_hip
         s[a_st] = tau_stance_hip
-        s[a_sw + 1] = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + 1], swing.thigh_angle), _KNEE_LIMIT)
-        s[a_st + 1] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
-        for leg, i in ((swing, sw_i), (stance, st_i)):
-            foot_rate = pitch_rate + v[i] - v[i + 1] + v[i + 2]
+        s[a_sw + KNEE] = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + KNEE], swing.thigh_angle), _KNEE_LIMIT)
+        s[a_st + KNEE] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
+        for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
+            foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
             slope = ground.slope_at(leg.ankle_x)
-            s[TAU + i - 1] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
+            s[a + ANKLE] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
 
         # Fall detection and the end of the episode.
         if pz - ground.height(px) < self._fall_height:

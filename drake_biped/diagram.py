@@ -96,8 +96,8 @@ def build_diagram(
     plant = handles.plant
     _, _, stance_right, liftoff = initial_state(config)
     controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, stance_right, liftoff))
-    builder.Connect(plant.get_state_output_port(), controller.get_input_port(0))
-    builder.Connect(controller.GetOutputPort("actuation"), plant.get_actuation_input_port())
+    builder.Connect(plant.get_state_output_port(), controller.get_input_port_plant_state())
+    builder.Connect(controller.get_output_port_actuation(), plant.get_actuation_input_port())
     if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:
         push = builder.AddNamedSystem("torso_push", TorsoPush(plant, config.push))
         builder.Connect(push.get_output_port(), plant.get_applied_spatial_force_input_port())
@@ -106,8 +106,8 @@ def build_diagram(
         period = log_period_s or config.sim.control_period_s
         for name, port in (
             ("state_log", plant.get_state_output_port()),
-            ("controller_log", controller.GetOutputPort("controller_state")),
-            ("actuation_log", controller.GetOutputPort("actuation")),
+            ("controller_log", controller.get_output_port_controller_state()),
+            ("actuation_log", controller.get_output_port_actuation()),
         ):
             logs[name] = LogVectorOutput(port, builder, period)
             logs[name].set_name(name)

@@ -20,7 +20,7 @@ from drake_biped.analysis.cost_of_transport import cost_of_transport, cost_of_tr
 from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
-from drake_biped.model import JOINT_NAMES
+from drake_biped.model import JOINT_NAMES, joint_index
 from drake_biped.params import GRAVITY_MPS2, TOTAL_MASS_KG, EpisodeConfig
 from drake_biped.versions import versions
 
@@ -35,6 +35,10 @@ class StepRecord:
     hip_rate_radps: float
     stance_leg: str
     com_x_m: float
+
+
+STEP_ARRAY_DTYPE = np.dtype([("index", int), ("touchdown_time_s", float), ("hip_angle_rad", float),
+                             ("hip_rate_radps", float), ("stance_right", bool), ("com_x_m", float)])
 
 
 @dataclass
@@ -69,6 +73,19 @@ class EpisodeResult:
     @property
     def total_positive_work_j(self) -> float:
         return self.positive_work_j["total"]
+
+    @property
+    def touchdowns(self) -> np.ndarray:
+        """The steps as one structured array, a row per touchdown: `touchdowns["hip_angle_rad"]` is the
+        section angles, `touchdowns["touchdown_time_s"]` their times (fields: STEP_ARRAY_DTYPE)."""
+        return np.array([(s.index, s.touchdown_time_s, s.hip_angle_rad, s.hip_rate_radps, s.stance_leg == "right",
+                          s.com_x_m) for s in self.steps], dtype=STEP_ARRAY_DTYPE)
+
+    @property
+    def sections(self) -> np.ndarray:
+        """The Poincare section states (hip angle, hip rate) of the steps, shape (steps, 2): what
+        `fit_return_map` takes."""
+        return np.array([[s.hip_angle_rad, s.hip_rate_radps] for s in self.steps], dtype=float).reshape(-1, 2)
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -210,10 +227,9 @@ def simulate(
     try:
         if kick is not None and kick.time_s < config.sim.max_time_s:
             simulator.AdvanceTo(kick.time_s)
-            s = ctrl_ctx.get_discrete_state(group)
-            if s.GetAtIndex(ctl.FALL) == 0.0 and s.GetAtIndex(ctl.DONE) == 0.0:
-                swing = "left_hip" if s.GetAtIndex(ctl.STANCE_RIGHT) > 0.5 else "right_hip"
-                i = 3 + JOINT_NAMES.index(swing)
+            s = parts.controller.state(ctrl_ctx)
+            if s.fall_code == 0.0 and s.done == 0.0:
+                i = 3 + joint_index("left" if s.stance_right > 0.5 else "right", "hip")  # the swing hip
                 q = parts.plant.GetPositions(plant_ctx).copy()
                 v = parts.plant.GetVelocities(plant_ctx).copy()
                 q[i] += kick.hip_angle_rad
@@ -221,8 +237,8 @@ def simulate(
                 parts.plant.SetPositions(plant_ctx, q)
                 parts.plant.SetVelocities(plant_ctx, v)
         simulator.AdvanceTo(config.sim.max_time_s)
-        s = ctrl_ctx.get_discrete_state(group)
-        reason = "fall" if s.GetAtIndex(ctl.FALL) != 0.0 else ("distance" if s.GetAtIndex(ctl.DONE) else "time limit")
+        s = parts.controller.state(ctrl_ctx)
+        reason = "fall" if s.fall_code != 0.0 else ("distance" if s.done else "time limit")
     except RuntimeError as exc:  # a diverging contact solve: the episode is a fall, not a crash
         reason = f"simulation failed: {exc}".splitlines()[0]
     wall = time.perf_counter() - wall0
@@ -248,19 +264,21 @@ def run_episode(
     )
     context = simulator.get_context()
     ctrl_ctx = parts.controller.GetMyContextFromRoot(context)
-    s = ctrl_ctx.get_discrete_state(parts.controller.state_group).value().copy()
-    t_end = float(s[ctl.STATE_TIME])
-    fall_code = int(s[ctl.FALL])
+    s = parts.controller.state(ctrl_ctx)
+    t_end = s.state_time_s
+    fall_code = int(s.fall_code)
     fell = reason != "distance" and reason != "time limit"
     fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
 
     q0, _, _, _ = initial_state(config)
-    distance = float(s[ctl.COM_X]) - center_of_mass(q0)[0]
+    distance = s.com_x_m - center_of_mass(q0)[0]
 
-    positive = {n: float(s[ctl.POSITIVE_WORK + i]) for i, n in enumerate(JOINT_NAMES)}
-    positive["total"] = float(sum(s[ctl.POSITIVE_WORK : ctl.POSITIVE_WORK + 6]))
-    signed = {n: float(s[ctl.SIGNED_WORK + i]) for i, n in enumerate(JOINT_NAMES)}
-    signed["total"] = float(sum(s[ctl.SIGNED_WORK : ctl.SIGNED_WORK + 6]))
+    work = s.positive_work_j
+    positive = {n: float(work[i]) for i, n in enumerate(JOINT_NAMES)}
+    positive["total"] = float(sum(work))
+    work = s.signed_work_j
+    signed = {n: float(work[i]) for i, n in enumerate(JOINT_NAMES)}
+    signed["total"] = float(sum(work))
 
     steps = step_records(parts.controller.touchdowns(ctrl_ctx))
     if len(steps) >= 3:
@@ -317,17 +335,18 @@ def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
     """The logged signals (the diagram must have been built with record=True)."""
     states = parts.state_log.FindLog(context)
     acts = parts.actuation_log.FindLog(context)
-    ctrl = parts.controller_log.FindLog(context)
+    ctrl = parts.controller_log.FindLog(context).data()
+    rows = ctl.CONTROLLER_STATE.rows
     return {
         "time": states.sample_times().copy(),
         "positions": states.data()[:9].T.copy(),
         "velocities": states.data()[9:].T.copy(),
         "actuation": acts.data().T.copy(),
-        "cpg_phase": ctrl.data()[ctl.GAMMA].copy(),
-        "torque_free": ctrl.data()[ctl.GATE].copy(),
-        "stance_right": ctrl.data()[ctl.STANCE_RIGHT].copy(),
-        "step_start": ctrl.data()[ctl.STEP_START].copy(),
-        "positive_work": ctrl.data()[ctl.POSITIVE_WORK : ctl.POSITIVE_WORK + 6].T.copy(),
+        "cpg_phase": rows(ctrl, "cpg_phase"),
+        "torque_free": rows(ctrl, "torque_free"),
+        "stance_right": rows(ctrl, "stance_right"),
+        "step_start": rows(ctrl, "step_start_s"),
+        "positive_work": rows(ctrl, "positive_work_j"),
         "position_names": np.array(["x", "z", "pitch", *JOINT_NAMES]),
         "actuator_names": np.array([f"{n}_motor" for n in JOINT_NAMES]),
     }

@@ -44,15 +44,16 @@ class _DropHalfSpaceWarning(logging.Filter):
 if not any(isinstance(f, _DropHalfSpaceWarning) for f in logging.getLogger("drake").filters):
     logging.getLogger("drake").addFilter(_DropHalfSpaceWarning())
 
-# Joint order used everywhere in the toolkit (positions 3..8, velocities 3..8, actuators 0..5).
-JOINT_NAMES = (
-    "left_hip",
-    "left_knee",
-    "left_ankle",
-    "right_hip",
-    "right_knee",
-    "right_ankle",
-)
+# Legs and their joints, and the joint order used everywhere in the toolkit (positions 3..8, velocities
+# 3..8, actuators 0..5): left hip, knee, ankle, then right.
+LEGS = ("left", "right")
+JOINTS_OF_A_LEG = ("hip", "knee", "ankle")
+JOINT_NAMES = tuple(f"{leg}_{joint}" for leg in LEGS for joint in JOINTS_OF_A_LEG)
+
+
+def joint_index(leg: str, joint: str) -> int:
+    """Index of a leg's joint in JOINT_NAMES and in the actuation vector (add 3 for the plant's positions)."""
+    return JOINT_NAMES.index(f"{leg}_{joint}")
 BASE_NAMES = ("x", "z", "pitch")
 FOOT_BODIES = ("left_foot", "right_foot")
 

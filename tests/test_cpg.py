@@ -9,6 +9,7 @@ from pydrake.systems.analysis import Simulator
 from drake_biped import controller as ctl
 from drake_biped import cpg
 from drake_biped.diagram import initial_state
+from drake_biped.model import joint_index
 from drake_biped.params import CpgParams, EpisodeConfig, TorqueFreeWindow
 
 
@@ -49,7 +50,7 @@ def _controller_alone(config):
     c = ctl.CpgWalkingController(config, stance_right, liftoff)
     sim = Simulator(c)
     ctx = sim.get_mutable_context()
-    c.get_input_port(0).FixValue(ctx, np.concatenate([q, v * 0.0]))
+    c.get_input_port_plant_state().FixValue(ctx, np.concatenate([q, v * 0.0]))
     c.set_initial_state(ctx, q[3:], 0.0)
     return c, sim, ctx
 
@@ -59,22 +60,22 @@ def test_phase_matches_closed_form_when_kappa_is_zero():
     c, sim, ctx = _controller_alone(config)
     for t in (0.1, 0.5, 1.0, 1.4):
         sim.AdvanceTo(t)
-        gamma = ctx.get_discrete_state(c.state_group).GetAtIndex(ctl.GAMMA)
+        gamma = c.state(ctx).cpg_phase
         # Updates at 0, dt, ..., t - dt have been applied by time t: gamma = u_r * t (Euler is exact here).
         assert gamma == pytest.approx(min(cpg.closed_form_phase(config.cpg, t), math.pi), abs=1e-9)
     sim.AdvanceTo(2.0)
-    assert ctx.get_discrete_state(c.state_group).GetAtIndex(ctl.GAMMA) == pytest.approx(math.pi)
+    assert c.state(ctx).cpg_phase == pytest.approx(math.pi)
 
 
 def test_kappa_feeds_stance_ankle_rate_into_phase():
     config = EpisodeConfig(cpg=CpgParams(u_a=2.0, u_r=2.0, kappa=1.5))
     c, sim, ctx = _controller_alone(config)
     q, v, _, _ = initial_state(config)
-    x = c.get_input_port(0).Eval(ctx).copy()
-    x[9 + 8] = 0.4  # right (stance) ankle rate
-    c.get_input_port(0).FixValue(ctx, x)
+    x = c.get_input_port_plant_state().Eval(ctx).copy()
+    x[9 + 3 + joint_index("right", "ankle")] = 0.4  # right (stance) ankle rate
+    c.get_input_port_plant_state().FixValue(ctx, x)
     sim.AdvanceTo(0.5)
-    assert ctx.get_discrete_state(c.state_group).GetAtIndex(ctl.GAMMA) == pytest.approx((2.0 + 1.5 * 0.4) * 0.5)
+    assert c.state(ctx).cpg_phase == pytest.approx((2.0 + 1.5 * 0.4) * 0.5)
 
 
 def test_gate_zeroes_swing_hip_and_freezes_integrator():
@@ -82,24 +83,24 @@ def test_gate_zeroes_swing_hip_and_freezes_integrator():
     config = EpisodeConfig(window=window)
     config = config.replace(gait=config.gait.__class__(**{**config.gait.to_dict(), "hip_ki": 50.0}))
     c, sim, ctx = _controller_alone(config)
-    swing_hip = 0  # left hip: the left leg is the first swing leg
+    swing_hip = joint_index("left", "hip")  # the left leg is the first swing leg
     seen_in, seen_out = 0, 0
     integral_at_start = None
     t = 0.0
     while t < 0.2:
         t = round(t + config.sim.control_period_s, 9)
         sim.AdvanceTo(t)
-        tau = ctx.get_discrete_state(0).value()
-        s = ctx.get_discrete_state(c.state_group).value()
+        tau = c.get_output_port_actuation().Eval(ctx)
+        s = c.state(ctx)
         last_update = t - config.sim.control_period_s  # the torque now held was computed at this time
         if window.start_s <= last_update - 1e-9 and last_update < window.end_s - 1e-9:
             assert tau[swing_hip] == 0.0
-            assert s[ctl.GATE] == 1.0
-            integral_at_start = s[ctl.INTEGRAL] if integral_at_start is None else integral_at_start
-            assert s[ctl.INTEGRAL] == integral_at_start
+            assert s.torque_free == 1.0
+            integral_at_start = s.hip_integral if integral_at_start is None else integral_at_start
+            assert s.hip_integral == integral_at_start
             seen_in += 1
         elif last_update > window.end_s + 1e-9 or last_update < window.start_s - 1e-9:
             assert abs(tau[swing_hip]) > 0.1
-            assert s[ctl.GATE] == 0.0
+            assert s.torque_free == 0.0
             seen_out += 1
     assert seen_in >= 60 and seen_out >= 100
