@@ -1,4 +1,4 @@
-"""Linear Poincaré return maps (SPEC §6.3, Table VI): the least-squares fit from section data, and the
+"""Linear Poincaré return maps (the paper's Table VI): the least-squares fit from section data, and the
 step-to-step Jacobian by finite differences. Plain numpy; nothing here knows about Drake.
 
 The return map linearised about the fixed point x* is x_{n+1} - x* = A (x_n - x*). With the deviations of

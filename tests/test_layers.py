@@ -1,4 +1,4 @@
-"""The package's layers (SPEC §1): every import runs downwards or within a layer, and no file imports
+"""The package's layers (core below analysis of records, below experiments, below the CLI): every import runs downwards or within a layer, and no file imports
 itself round a circle. Read from the source with `ast`, function-level imports included."""
 
 import ast

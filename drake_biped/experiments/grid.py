@@ -1,4 +1,4 @@
-"""Grid search over CPG parameters and the initiation (SPEC §6.5, Table IV), on Dask.
+"""Grid search over CPG parameters and the initiation (the paper's Table IV), on Dask.
 
 Every grid point is one episode (walk until a fall or the distance) of the base configuration with the
 point's values put in. The axes are dotted EpisodeConfig fields (`cpg.u_a`, `initial.speed_mps`,

@@ -1,4 +1,4 @@
-"""Reproduce the paper in one command (SPEC §6): every experiment, then one report beside the paper's numbers.
+"""Reproduce the paper in one command: every experiment, then one report beside the paper's numbers.
 
 `drake-biped reproduce --out DIR [--quick]` runs, each into its own folder of DIR and through the same
 functions as its own command:

@@ -1,4 +1,4 @@
-"""Slope adaptation (SPEC §6.4, the paper's Figs. 8-11), on Dask.
+"""Slope adaptation (the paper's Experiment 3, Figs. 8-11), on Dask.
 
 The ground is level for `level_length_m` (2 m), then ascends at `slope_rad`. An episode *climbs* when it
 reaches the episode's distance (10 m: 2 m level, 8 m up) without falling. Three questions, each answered by

@@ -1,4 +1,4 @@
-"""Pushes and Poincaré return maps (SPEC §6.2-6.3, Table VI, Fig. 7), on Dask.
+"""Pushes and Poincaré return maps (the paper's Experiment 2: Table VI, Fig. 7), on Dask.
 
 Six cells: the gait without and with a torque-free period, each undisturbed, pushed forward and pushed
 backward (20 N on the torso for 0.1 s, 0.4 s into the trial). Each cell runs `trials` episodes; trial 0
