@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 OUT ?= out
 
-.PHONY: setup reproduce walk test test-fast lint format window-map bench clean
+.PHONY: setup reproduce walk test lint format window-map bench package-check clean
 
 setup: $(VENV)/.installed
 
@@ -25,6 +25,10 @@ walk: setup
 
 test: setup
 	$(PY) -m pytest -q
+
+# Build the wheel, install it into a fresh venv and run the CLI, the API and an example outside the checkout.
+package-check:
+	bash .ci/package-check
 
 lint: setup
 	$(VENV)/bin/ruff check .
