@@ -1,4 +1,4 @@
-"""Specific mechanical cost of transport (Collins et al., Science 2005) and the paper's per-kg variant."""
+"""Specific mechanical cost of transport (eq. 1; Collins et al., Science 2005) and the paper's per-kg variant."""
 
 from __future__ import annotations
 

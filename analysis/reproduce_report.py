@@ -243,7 +243,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"**Grid on 0.02 rad** (`grid_slope/`, {gs['points']} points): {gs['walked']} climb; best "
         + ", ".join(f"{k.split('.')[-1]} {v:.4g}" for k, v in gs["best"]["point"].items())
         + f" (C_mt {_num(gs['best']['cost_of_transport'])}). The climbing gait used below is "
-        "`params/climbing_gait.json`, the full grid's best.",
+        "`--params climbing`, the full grid's best.",
         "",
     ]
     for name, figs in (("slope", "Figs. 8–9"), ("slope2deg", "Figs. 10–11")):
@@ -266,7 +266,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                 "climb)",
                 "",
                 f"Verdict: **{vii_verdict}**. Ours: from the 0.02 rad climbing gait to the grid's best on 2.0°; the "
-                "2.0° slope story runs `params/climbing_gait_2deg.json`, the full grid's best.",
+                "2.0° slope story runs `--params climbing_2deg`, the full grid's best.",
                 "",
                 "| parameter | paper: Table III → Table VII | ours: 0.02 rad gait → 2.0° best |",
                 "|---|---|---|",

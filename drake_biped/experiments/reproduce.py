@@ -144,18 +144,19 @@ class Reproduction:
         return self.experiment("time_step", settings, run)
 
     def grid(self) -> dict:
+        from drake_biped.experiments import grid
         from drake_biped.experiments.executor import run_kept
-        from drake_biped.experiments.grid import run_grid, table_iv_axes
 
         p = self.profile
         settings = {"points": p.grid_points, "initiation_points": p.grid_initiation_points,
                     "distance_m": p.distance_m}
 
         def run(folder: Path) -> dict:
-            axes = table_iv_axes(p.grid_points, p.grid_initiation_points)
+            axes = grid.table_iv_axes(p.grid_points, p.grid_initiation_points)
             table_iii = self.level.replace(cpg=PAPER_CPG, initial=InitialConditions())
+            record = grid.run(grid.GridSettings(self.level, tuple(axes)), folder, self._client, progress=False,
+                              workers=self.workers, scheduler=self.scheduler)
             with self.client() as client:
-                record = run_grid(folder, self.level, axes, client)
                 paper = run_kept(client, {"t": (folder / "table_iii.json", table_iii.to_dict())})["t"]
             return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
                     "table_iii": {"distance_m": paper["distance_m"], "fell": paper["fell"],
@@ -250,7 +251,8 @@ class Reproduction:
                     subset: dict[str, list[float]]):
         """A grid on 2 m level then `slope`, from the default gait (base_file None) or a shipped gait: the
         shipped grid spec `spec` (full), or the 2 x 2 `subset` through its best (quick)."""
-        from drake_biped.experiments.grid import Axis, field_name, load_spec, run_grid
+        from drake_biped.experiments import grid
+        from drake_biped.experiments.grid import Axis, field_name, load_spec
         from drake_biped.experiments.slope import slope_ground
 
         full = self.profile.slope_grid_full
@@ -259,8 +261,8 @@ class Reproduction:
         def run(folder: Path) -> dict:
             axes = load_spec(spec) if full else [Axis(field_name(k), tuple(v)) for k, v in subset.items()]
             base = (EpisodeConfig() if base_file is None else load_gait(base_file)).replace(ground=slope_ground(slope))
-            with self.client() as client:
-                record = run_grid(folder, base, axes, client)
+            record = grid.run(grid.GridSettings(base, tuple(axes)), folder, self._client, progress=False,
+                              workers=self.workers, scheduler=self.scheduler)
             return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
                     "base_cpg": base.cpg.to_dict()}
 
