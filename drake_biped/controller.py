@@ -30,7 +30,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
 from drake_biped import cpg, gait
-from drake_biped.kinematics import center_of_mass_from_legs, leg_points
+from drake_biped.kinematics import TABLE_I_MASSES, LinkMasses, center_of_mass_from_legs, leg_points
 from drake_biped.layout import Field, VectorLayout
 from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
 from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
@@ -107,8 +107,11 @@ _ANKLE_LIMIT = EFFORT_LIMITS_NM["ankle"]
 class CpgWalkingController(LeafSystem):
     """CPG + torque-free gate + hip PID + knee/ankle/stance logic for the 7-link biped."""
 
-    def __init__(self, config: EpisodeConfig, initial_stance_right: bool, initial_liftoff_angle: float):
+    def __init__(self, config: EpisodeConfig, initial_stance_right: bool, initial_liftoff_angle: float,
+                 masses: LinkMasses = TABLE_I_MASSES):
+        """`masses`: the model's link masses (`model.link_masses_of`), for the centre of mass."""
         super().__init__()
+        self._masses = masses
         # Structure: fixed for the life of the system.
         self._structure = self.structure_key(config)
         self._ground = config.ground
@@ -229,7 +232,7 @@ class CpgWalkingController(LeafSystem):
         stance_right = s[STANCE_RIGHT] > 0.5
         st_i, sw_i = _LEG_Q[stance_right]
         stance, swing = (right, left) if stance_right else (left, right)
-        com_x = center_of_mass_from_legs(px, pz, pitch, left, right)[0]
+        com_x = center_of_mass_from_legs(px, pz, pitch, left, right, self._masses)[0]
         s[COM_X] = com_x
 
         # Touchdown: swap the roles, reset the CPG phase (phase resetting), record the section state.

@@ -14,7 +14,7 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, Vector
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_biped.controller import CpgWalkingController
-from drake_biped.kinematics import leg_points
+from drake_biped.kinematics import LinkMasses, leg_points
 from drake_biped.model import add_biped
 from drake_biped.params import EpisodeConfig, Push
 
@@ -49,6 +49,7 @@ class BipedDiagram:
     diagram: Diagram
     plant: MultibodyPlant
     controller: CpgWalkingController
+    masses: LinkMasses  # the model's, as the plant holds them
     state_log: VectorLogSink | None = None
     controller_log: VectorLogSink | None = None
     actuation_log: VectorLogSink | None = None
@@ -95,7 +96,8 @@ def build_diagram(
     )
     plant = handles.plant
     _, _, stance_right, liftoff = initial_state(config)
-    controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, stance_right, liftoff))
+    controller = builder.AddNamedSystem("cpg_controller",
+                                        CpgWalkingController(config, stance_right, liftoff, handles.masses))
     builder.Connect(plant.get_state_output_port(), controller.get_input_port_plant_state())
     builder.Connect(controller.get_output_port_actuation(), plant.get_actuation_input_port())
     if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:
@@ -119,7 +121,7 @@ def build_diagram(
         )
     diagram = builder.Build()
     diagram.set_name("drake_biped")
-    return BipedDiagram(diagram, plant, controller, **logs)
+    return BipedDiagram(diagram, plant, controller, handles.masses, **logs)
 
 
 def build_replay_diagram(

@@ -21,7 +21,7 @@ from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
 from drake_biped.model import JOINT_NAMES, joint_index
-from drake_biped.params import GRAVITY_MPS2, TOTAL_MASS_KG, EpisodeConfig
+from drake_biped.params import GRAVITY_MPS2, EpisodeConfig
 from drake_biped.versions import versions
 
 
@@ -206,7 +206,7 @@ def simulate(
     q0, v0, stance_right, liftoff = initial_state(config)
     parts.plant.SetPositions(plant_ctx, q0)
     parts.plant.SetVelocities(plant_ctx, v0)
-    com_x0 = center_of_mass(q0)[0]
+    com_x0 = center_of_mass(q0, parts.masses)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
     parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff)
     group = parts.controller.state_group
@@ -271,7 +271,7 @@ def run_episode(
     fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
 
     q0, _, _, _ = initial_state(config)
-    distance = s.com_x_m - center_of_mass(q0)[0]
+    distance = s.com_x_m - center_of_mass(q0, parts.masses)[0]
 
     work = s.positive_work_j
     positive = {n: float(work[i]) for i, n in enumerate(JOINT_NAMES)}
@@ -289,8 +289,9 @@ def run_episode(
     else:
         step_period = step_length = None
 
-    cmt = cost_of_transport(positive["total"], TOTAL_MASS_KG, distance, GRAVITY_MPS2)
-    cmt_kg = cost_of_transport_per_kg(positive["total"], TOTAL_MASS_KG, distance)
+    mass = parts.masses.total  # the model's, not Table I's
+    cmt = cost_of_transport(positive["total"], mass, distance, GRAVITY_MPS2)
+    cmt_kg = cost_of_transport_per_kg(positive["total"], mass, distance)
     trajectory = _trajectory(parts, context) if record_trajectory else None
     return EpisodeResult(
         config=config.to_dict(),
@@ -307,7 +308,7 @@ def run_episode(
         mean_speed_mps=float(distance / t_end) if t_end > 0 else 0.0,
         step_period_s=step_period,
         step_length_m=step_length,
-        mass_kg=TOTAL_MASS_KG,
+        mass_kg=mass,
         wall_time_s=wall,
         real_time_factor=float(t_end / wall) if wall > 0 else math.inf,
         seed=config.seed,

@@ -3,6 +3,9 @@
 Sign conventions (see models/biped.urdf): x forward, z up, every angle counter-clockwise in the x-z view.
 The torso pitch is positive when leaning back; a thigh's world angle is pitch + hip and is positive when
 the foot is ahead of the hip; the shank's is thigh - knee; the foot's is shank + ankle.
+Lengths, centres of mass and the foot's contact points are the model's: `model.check_geometry` compares
+the constants below with the plant when a diagram is built and refuses a model that differs. Masses are
+read from the plant (`model.link_masses`) and passed in; Table I's are only the default of the functions.
 `tests/test_kinematics.py` checks these functions against MultibodyPlant.
 """
 
@@ -12,15 +15,33 @@ import math
 from typing import NamedTuple
 
 from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
-from drake_biped.params import CONTACT_RADIUS_M, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M, TOTAL_MASS_KG
+from drake_biped.params import CONTACT_RADIUS_M, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M
 
 THIGH_M = TABLE_I_LENGTHS_M["thigh"]
 SHANK_M = TABLE_I_LENGTHS_M["shank"]
 TORSO_M = TABLE_I_LENGTHS_M["torso"]
 # Contact spheres: centre one radius above the sole, at the heel and at the toe.
 _SPHERE_Z = -SOLE_DEPTH_M + CONTACT_RADIUS_M
-_FOOT_COM = (0.03, -0.015)  # foot centre of mass in the ankle frame (m)
-_M_TORSO, _M_THIGH, _M_SHANK, _M_FOOT = (TABLE_I_MASSES_KG[k] for k in ("torso", "thigh", "shank", "foot"))
+FOOT_COM_M = (0.03, -0.015)  # foot centre of mass in the ankle frame (x, z; m)
+_FOOT_COM = FOOT_COM_M
+
+
+class LinkMasses(NamedTuple):
+    """Masses (kg) of the torso and of one leg's thigh, shank and foot (the legs are mirror images), and
+    the whole robot's."""
+
+    torso: float
+    thigh: float
+    shank: float
+    foot: float
+    total: float
+
+
+def link_masses(torso: float, thigh: float, shank: float, foot: float) -> LinkMasses:
+    return LinkMasses(torso, thigh, shank, foot, torso + 2 * (thigh + shank + foot))
+
+
+TABLE_I_MASSES = link_masses(*(TABLE_I_MASSES_KG[k] for k in ("torso", "thigh", "shank", "foot")))
 
 
 class LegPoints(NamedTuple):
@@ -57,17 +78,18 @@ def leg_points(x: float, z: float, pitch: float, hip: float, knee: float, ankle:
     return LegPoints(kx, kz, ax, az, hx, hz, tx, tz, thigh, shank, foot)
 
 
-def center_of_mass(q) -> tuple[float, float]:
+def center_of_mass(q, masses: LinkMasses = TABLE_I_MASSES) -> tuple[float, float]:
     """Whole-body centre of mass (x, z) for q = (x, z, pitch, hipL, kneeL, ankleL, hipR, kneeR, ankleR)."""
     x, z, pitch = q[0], q[1], q[2]
     return center_of_mass_from_legs(
-        x, z, pitch, leg_points(x, z, pitch, q[3], q[4], q[5]), leg_points(x, z, pitch, q[6], q[7], q[8])
+        x, z, pitch, leg_points(x, z, pitch, q[3], q[4], q[5]), leg_points(x, z, pitch, q[6], q[7], q[8]), masses
     )
 
 
-def center_of_mass_from_legs(x: float, z: float, pitch: float, left: LegPoints, right: LegPoints) -> tuple[float, float]:
+def center_of_mass_from_legs(x: float, z: float, pitch: float, left: LegPoints, right: LegPoints,
+                             masses: LinkMasses = TABLE_I_MASSES) -> tuple[float, float]:
     """Centre of mass from the hip position, torso pitch and both legs' points (already computed)."""
-    mt, mth, msh, mft = _M_TORSO, _M_THIGH, _M_SHANK, _M_FOOT
+    mt, mth, msh, mft, total = masses
     sx = mt * (x - 0.5 * TORSO_M * math.sin(pitch))
     sz = mt * (z + 0.5 * TORSO_M * math.cos(pitch))
     for p in (left, right):
@@ -76,4 +98,4 @@ def center_of_mass_from_legs(x: float, z: float, pitch: float, left: LegPoints, 
         c, s = math.cos(p.foot_angle), math.sin(p.foot_angle)
         sx += mft * (p.ankle_x + _FOOT_COM[0] * c - _FOOT_COM[1] * s)
         sz += mft * (p.ankle_z + _FOOT_COM[0] * s + _FOOT_COM[1] * c)
-    return sx / TOTAL_MASS_KG, sz / TOTAL_MASS_KG
+    return sx / total, sz / total

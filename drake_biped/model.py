@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import AddContactMaterial, Box, HalfSpace, ProximityProperties, SceneGraph
+from pydrake.geometry import AddContactMaterial, Box, HalfSpace, ProximityProperties, SceneGraph, Sphere
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import (
@@ -24,7 +24,8 @@ from pydrake.multibody.plant import (
 )
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_biped.params import Ground
+from drake_biped.kinematics import FOOT_COM_M, SHANK_M, THIGH_M, TORSO_M, LinkMasses, link_masses
+from drake_biped.params import CONTACT_RADIUS_M, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M, Ground
 from drake_biped.resources import model_package_xml
 
 MODEL_URL = "package://drake_biped/biped.urdf"
@@ -66,6 +67,7 @@ class ModelError(RuntimeError):
 class PlantHandles:
     plant: MultibodyPlant
     scene_graph: SceneGraph
+    masses: LinkMasses  # read from the model file: every per-kg figure and the centre of mass use these
 
 
 def add_biped(
@@ -101,7 +103,8 @@ def add_biped(
     _add_ground(plant, ground)
     plant.Finalize()
     check_layout(plant)
-    return PlantHandles(plant, scene_graph)
+    check_geometry(plant, scene_graph)
+    return PlantHandles(plant, scene_graph, link_masses_of(plant))
 
 
 def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
@@ -144,6 +147,12 @@ def check_layout(plant: MultibodyPlant) -> None:
             f"expected 9 positions, 9 velocities and 6 actuators, got {plant.num_positions()}, "
             f"{plant.num_velocities()}, {plant.num_actuators()}"
         )
+    for name in ("floating_base", *JOINT_NAMES):
+        if not plant.HasJointNamed(name):
+            raise ModelError(f"the model has no joint named {name!r}; expected {['floating_base', *JOINT_NAMES]}")
+    for name in JOINT_NAMES:
+        if not plant.HasJointActuatorNamed(f"{name}_motor"):
+            raise ModelError(f"the model has no actuator named {name + '_motor'!r} (a <transmission> for joint {name})")
     base = plant.GetJointByName("floating_base")
     if base.type_name() != "planar" or base.position_start() != 0:
         raise ModelError("the floating base must be the planar joint at position 0")
@@ -154,6 +163,58 @@ def check_layout(plant: MultibodyPlant) -> None:
         actuator = plant.GetJointActuatorByName(f"{name}_motor")
         if int(actuator.index()) != i:
             raise ModelError(f"actuator {name}_motor has index {int(actuator.index())}, expected {i}")
+
+
+def link_masses_of(plant: MultibodyPlant) -> LinkMasses:
+    """The links' masses as the model file gives them; ModelError unless the legs are mirror images (the
+    controller's centre of mass takes one mass per link kind)."""
+    def mass(name: str) -> float:
+        return float(plant.GetBodyByName(name).default_mass())
+
+    legs = {leg: tuple(mass(f"{leg}_{link}") for link in ("thigh", "shank", "foot")) for leg in LEGS}
+    if legs["left"] != legs["right"]:
+        raise ModelError(f"the legs' masses differ (left thigh, shank, foot {legs['left']} kg, right "
+                         f"{legs['right']} kg); the toolkit assumes mirror-image legs")
+    return link_masses(mass("torso"), *legs["left"])
+
+
+def check_geometry(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: float = 1e-9) -> None:
+    """Raise ModelError, naming the quantity and both values, unless the model's lengths, centres of mass and
+    foot contact spheres are those the controller's planar kinematics uses (`kinematics`): the controller
+    computes touchdowns, falls and the centre of mass from them."""
+    def check(what: str, model_value, expected) -> None:
+        model_value, expected = np.asarray(model_value, float), np.asarray(expected, float)
+        if model_value.shape != expected.shape or np.max(np.abs(model_value - expected)) > tolerance_m:
+            raise ModelError(f"the model's {what} is {np.round(model_value, 6).tolist()}, but the controller's "
+                             f"kinematics uses {np.round(expected, 6).tolist()} (drake_biped/kinematics.py)")
+
+    def xz(v) -> list[float]:
+        return [float(v[0]), float(v[2])]
+
+    check("torso centre of mass (x, z in the torso frame, m)", xz(plant.GetBodyByName("torso").default_com()),
+          [0.0, 0.5 * TORSO_M])
+    for leg in LEGS:
+        offset = plant.GetJointByName(f"{leg}_hip").frame_on_parent().GetFixedPoseInBodyFrame().translation()
+        check(f"{leg} hip position in the torso frame (x, z, m)", xz(offset), [0.0, 0.0])
+        for joint, parent, length in (("knee", "thigh", THIGH_M), ("ankle", "shank", SHANK_M)):
+            frame = plant.GetJointByName(f"{leg}_{joint}").frame_on_parent()
+            check(f"{leg} {joint} position in the {parent} frame (x, z, m; the {parent} length)",
+                  xz(frame.GetFixedPoseInBodyFrame().translation()), [0.0, -length])
+            check(f"{leg} {parent} centre of mass (x, z, m)", xz(plant.GetBodyByName(f"{leg}_{parent}").default_com()),
+                  [0.0, -0.5 * length])
+        foot = plant.GetBodyByName(f"{leg}_foot")
+        check(f"{leg} foot centre of mass (x, z in the ankle frame, m)", xz(foot.default_com()), list(FOOT_COM_M))
+        inspector = scene_graph.model_inspector()
+        spheres = []
+        for geometry in plant.GetCollisionGeometriesForBody(foot):
+            shape = inspector.GetShape(geometry)
+            if not isinstance(shape, Sphere):
+                raise ModelError(f"{leg}_foot collides through a {type(shape).__name__}; the controller's "
+                                 "kinematics expects a sphere at the heel and one at the toe")
+            spheres.append([*xz(inspector.GetPoseInFrame(geometry).translation()), shape.radius()])
+        check(f"{leg} foot contact spheres (x, z, radius in the ankle frame, m)", sorted(spheres),
+              [[HEEL_X_M, CONTACT_RADIUS_M - SOLE_DEPTH_M, CONTACT_RADIUS_M],
+               [TOE_X_M, CONTACT_RADIUS_M - SOLE_DEPTH_M, CONTACT_RADIUS_M]])
 
 
 def effort_limits(plant: MultibodyPlant) -> np.ndarray:

@@ -1,6 +1,7 @@
 """The plant read back from models/biped.urdf against Table I and the documented limits."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -128,3 +129,47 @@ def test_only_drakes_half_space_warning_is_dropped(caplog):
         drake_log.warning("another warning")
     assert [r.getMessage() for r in caplog.records] == [HALF_SPACE_WARNING + " (and something else)",
                                                          "another warning"]
+
+
+def _model_copy(tmp_path, edit) -> Path:
+    """A copy of the shipped model package with `edit` applied to the URDF text; its package.xml."""
+    from drake_biped.resources import model_package_xml
+
+    shipped = model_package_xml().parent
+    for name in ("package.xml", "biped.urdf"):
+        text = (shipped / name).read_text()
+        (tmp_path / name).write_text(edit(text) if name == "biped.urdf" else text)
+    return tmp_path / "package.xml"
+
+
+def test_a_heavier_torso_is_the_mass_of_the_cost_of_transport(tmp_path, monkeypatch):
+    """Physics from the model: with the torso 2 kg heavier in the URDF, the episode reports the model's
+    mass, and C_mt is the positive work over that mass's weight times the distance."""
+    import drake_biped.model as model
+    from drake_biped.episode import run_episode
+    from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, SimulationParams
+
+    heavier = _model_copy(tmp_path, lambda t: t.replace('<mass value="6.646"/>', '<mass value="8.646"/>', 1))
+    monkeypatch.setattr(model, "model_package_xml", lambda: heavier)
+    assert model.link_masses_of(model.build_plant()).total == pytest.approx(TOTAL_MASS_KG + 2.0, abs=1e-12)
+    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=1.0, max_time_s=6.0)), cache=None)
+    assert r.mass_kg == pytest.approx(12.202, abs=1e-12)
+    assert r.distance_m > 0.3
+    assert r.cost_of_transport == pytest.approx(r.total_positive_work_j / (12.202 * GRAVITY_MPS2 * r.distance_m))
+    assert r.cost_of_transport_per_kg == pytest.approx(r.total_positive_work_j / (12.202 * r.distance_m))
+
+
+@pytest.mark.parametrize("old, new, match", [
+    ('<origin xyz="0 0 -0.317"/>', '<origin xyz="0 0 -0.330"/>', r"left ankle position in the shank frame .* is \[0\.0, -0\.33\]"),
+    ('<origin xyz="0.0000 0 -0.1400"/>', '<origin xyz="0.0000 0 -0.1300"/>', "left thigh centre of mass"),
+    ('<origin xyz="0.1200 0.0000 -0.0200"/>', '<origin xyz="0.1300 0.0000 -0.0200"/>', "left foot contact spheres"),
+    ('<mass value="0.707"/>', '<mass value="0.800"/>', "the legs' masses differ"),
+    ('<joint name="left_knee" type="revolute">', '<joint name="left_knee_joint" type="revolute">',
+     "left_knee"),
+])
+def test_a_model_the_kinematics_does_not_match_is_refused_by_name(tmp_path, old, new, match):
+    from pydrake.systems.framework import DiagramBuilder
+
+    package = _model_copy(tmp_path, lambda t: t.replace(old, new, 1))
+    with pytest.raises(ModelError, match=match):
+        add_biped(DiagramBuilder(), Ground(), 1e-3, package_xml=package)
