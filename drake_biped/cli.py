@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from contextlib import contextmanager
 from pathlib import Path
 
+from drake_biped.model import ModelError
 from drake_biped.params import (
     EpisodeConfig,
     Ground,
@@ -56,20 +58,48 @@ def _integer(minimum: int):
     return parse
 
 
+def _out_folder(text: str) -> Path:
+    """--out: a folder that exists or can be made, and can be written; refused by name otherwise."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; name a folder (it is made if missing)")
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    new = [p for p in (path, *path.parents) if not p.exists()]
+    _MADE.extend(reversed(new))  # removed again, if still empty, when the command refuses its input
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".drake-biped-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
+_MADE: list[Path] = []  # folders --out made in this invocation
 _seed = _integer(0)
 _count = _integer(1)
 
 
-def _add_episode_options(p: argparse.ArgumentParser) -> None:
+def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
     p.add_argument("--params", help="a shipped gait by name (climbing, climbing_2deg) or a JSON file of "
                    "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
-    p.add_argument("--distance", type=_number("positive"), help="walk this far (m); default 10")
-    p.add_argument("--max-time", type=_number("positive"), help="simulated time limit (s); default 60")
-    p.add_argument("--time-step", type=_number("positive"), help="plant and control time step (s); default 0.001")
-    p.add_argument("--slope", type=_number("finite"), help="ground slope (rad, > 0 ascends)")
-    p.add_argument("--level-length", type=_number("nonnegative"),
-                   help="level ground for this many metres, then the slope")
-    p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default 0)")
+    p.add_argument("--distance", type=_number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
+    p.add_argument("--max-time", type=_number("positive"),
+                   help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
+    p.add_argument("--time-step", type=_number("positive"),
+                   help="plant and control time step (s) (default: 0.001)")
+    if slope_command:
+        p.add_argument("--slope", type=_number("finite"), required=True,
+                       help="the ascending slope after the level part (rad, > 0)")
+        p.add_argument("--level-length", type=_number("nonnegative"), default=2.0,
+                       help="level ground before the slope (m)")
+    else:
+        p.add_argument("--slope", type=_number("finite"), help="ground slope (rad, > 0 ascends) (default: 0, level)")
+        p.add_argument("--level-length", type=_number("nonnegative"),
+                       help="level ground for this many metres, then the slope (default: none, the slope everywhere)")
+    p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default: 0)")
 
 
 def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
@@ -121,13 +151,21 @@ def cmd_walk(args: argparse.Namespace) -> int:
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
     if args.t1 is not None:
+        if args.t2 <= args.t1:
+            raise ParameterError(f"--t1 {args.t1:g} --t2 {args.t2:g}: t2 <= t1 is no torque-free window; "
+                                 "give t1 < t2, or neither to walk without one")
         config = config.replace(window=TorqueFreeWindow(args.t1, args.t2))
     if args.push is not None:
         config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
+    elif args.push_start != 0.4 or args.push_duration != 0.1:
+        raise ParameterError("--push-start and --push-duration shape a push: give --push N too")
     out = Path(args.out)
     result = walk.run(walk.WalkSettings(config, animation=not args.no_animation,
                                         save_trajectory=args.save_trajectory), out)
     _print(walk.summary_lines(result))
+    if config.push is not None and result.duration_s <= config.push.start_s:
+        print(f"note: the episode ended at {result.duration_s:.2f} s, before the push at {config.push.start_s:g} s "
+              "started: it walked unpushed", file=sys.stderr)
     print(f"wrote {out}/")
     return 0
 
@@ -290,9 +328,7 @@ def cmd_grid(args: argparse.Namespace) -> int:
 def cmd_slope(args: argparse.Namespace) -> int:
     from drake_biped.experiments import slope
 
-    if args.slope is None:
-        raise ParameterError("--slope is required (rad, > 0: the ascending slope after the level part)")
-    level = args.level_length if args.level_length is not None else 2.0
+    level = args.level_length
     args.level_length = None  # the slope ground is built by the slope settings, not by the episode options
     slope_rad, args.slope = args.slope, None
     config = _episode_config(args)
@@ -354,32 +390,69 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
 def _add_resumable_run_options(p: argparse.ArgumentParser) -> None:
     """The cluster options and --out of a command that resumes when rerun."""
     _add_cluster_options(p)
-    p.add_argument("--out", required=True, help="output folder (rerun the same command to resume)")
+    p.add_argument("--out", required=True, type=_out_folder, help="output folder (rerun the same command to resume)")
+
+
+class _HelpFormatter(argparse.HelpFormatter):
+    """Every option's default in its help, unless the help already says it or there is none."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if "default" in text or action.required or default in (None, False, argparse.SUPPRESS):
+            return text
+        if isinstance(default, (list, tuple)):
+            default = " ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in default)
+        return f"{text} (default: {default})"
+
+
+class _Parser(argparse.ArgumentParser):
+    """Option errors as one line naming the option and the value (exit code 2), without the usage block."""
+
+    def error(self, message: str):
+        _remove_empty_made_folders()
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+RESUMABLE = ("gait-search", "learn", "stability", "grid", "slope", "reproduce")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="drake-biped", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="drake-biped", description=__doc__.splitlines()[0],
+                     epilog=f"Exit codes: 0 done, 1 a run failed, 2 bad input, 130 interrupted. --debug (or "
+                     f"{DEBUG_ENV}=1) shows the traceback of a failure.")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", help=f"on a failure, show the traceback (also {DEBUG_ENV}=1)")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    _add = sub.add_parser
+
+    def add_parser(name, **kwargs):
+        kwargs.setdefault("formatter_class", _HelpFormatter)
+        return _add(name, parents=[common], **kwargs)
+
+    sub.add_parser = add_parser
 
     walk = sub.add_parser("walk", help="walk one episode and write its record, figures and animation")
     _add_episode_options(walk)
-    walk.add_argument("--t1", type=_number("nonnegative"), help="torque-free start after each step start (s)")
-    walk.add_argument("--t2", type=_number("nonnegative"), help="torque-free end (s); t2 <= t1: no window")
-    walk.add_argument("--push", type=_number("finite"), help="horizontal push on the torso (N, + forward)")
-    walk.add_argument("--push-start", type=_number("nonnegative"), default=0.4, help="push start (s); default 0.4")
-    walk.add_argument("--push-duration", type=_number("positive"), default=0.1, help="push duration (s); default 0.1")
+    walk.add_argument("--t1", type=_number("nonnegative"),
+                      help="torque-free start after each step start (s); with --t2 (default: no window)")
+    walk.add_argument("--t2", type=_number("nonnegative"), help="torque-free end (s), after --t1 (default: no window)")
+    walk.add_argument("--push", type=_number("finite"), help="horizontal push on the torso (N, + forward) "
+                      "(default: none)")
+    walk.add_argument("--push-start", type=_number("nonnegative"), default=0.4, help="push start (s)")
+    walk.add_argument("--push-duration", type=_number("positive"), default=0.1, help="push duration (s)")
     walk.add_argument("--save-trajectory", action="store_true", help="also write trajectory.npz")
     walk.add_argument("--no-animation", action="store_true", help="skip walk.html and walk.gif")
-    walk.add_argument("--out", required=True, help="output folder")
+    walk.add_argument("--out", required=True, type=_out_folder, help="output folder")
     walk.set_defaults(func=cmd_walk)
 
     wmap = sub.add_parser("window-map", help="C_mt of a grid of torque-free windows against no window")
     _add_episode_options(wmap)
     wmap.add_argument("--step", type=_number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
-    wmap.add_argument("--t1-max", type=_number("nonnegative"), default=0.6, help="largest start t1 (s); default 0.6")
-    wmap.add_argument("--t2-max", type=_number("positive"), default=0.9, help="largest end t2 (s); default 0.9")
+    wmap.add_argument("--t1-max", type=_number("nonnegative"), default=0.6, help="largest start t1 (s)")
+    wmap.add_argument("--t2-max", type=_number("positive"), default=0.9, help="largest end t2 (s)")
     _add_cluster_options(wmap)
-    wmap.add_argument("--out", required=True, help="output folder")
+    wmap.add_argument("--out", required=True, type=_out_folder, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
 
     search = sub.add_parser("gait-search", help="evolve gait parameters for walking and torque-free savings")
@@ -397,7 +470,7 @@ def build_parser() -> argparse.ArgumentParser:
     ts.add_argument("--distance", type=_number("positive"), default=10.0, help="walk this far (m); default 10")
     _add_cluster_options(ts)
     ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
-    ts.add_argument("--out", required=True, help="output folder")
+    ts.add_argument("--out", required=True, type=_out_folder, help="output folder")
     ts.set_defaults(func=cmd_time_step_study)
 
     learn = sub.add_parser("learn", help="GARB learning of the torque-free period (Experiment 1), on Dask")
@@ -419,7 +492,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="a policy start to evaluate (default 0.5 0.5)")
     land.add_argument("--samples", type=_count, default=2000, help="Monte Carlo samples per mean (default 2000)")
     land.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
-    land.add_argument("--out", default=None, help="output folder (default: the window map's)")
+    land.add_argument("--out", default=None, type=_out_folder, help="output folder (default: the window map's)")
     land.set_defaults(func=cmd_landscape)
 
     stab = sub.add_parser("stability", help="pushes and Poincare return maps with and without a torque-free "
@@ -440,7 +513,7 @@ def build_parser() -> argparse.ArgumentParser:
     pm.add_argument("--max-force", type=_number("positive"), default=200.0, help="largest push tried (N); default 200")
     pm.add_argument("--tolerance", type=_number("positive"), default=1.0, help="bisection tolerance (N); default 1")
     _add_cluster_options(pm)
-    pm.add_argument("--out", required=True, help="output folder")
+    pm.add_argument("--out", required=True, type=_out_folder, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
 
     grid = sub.add_parser("grid", help="grid search of CPG parameters and the initiation (Table IV), on Dask")
@@ -455,7 +528,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sl = sub.add_parser("slope", help="slope adaptation: does the learned torque-free period climb, does none, "
                         "and does online GARB learning adapt it (Figs. 8-11), on Dask")
-    _add_episode_options(sl)
+    _add_episode_options(sl, slope_command=True)
     _add_window_options(sl)
     sl.add_argument("--variance", type=_number("positive"), default=0.04,
                     help="the policy's variance (s^2) when starting from --t1/--t2; default 0.04 as in the paper "
@@ -477,14 +550,56 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+DEBUG_ENV = "DRAKE_BIPED_DEBUG"
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 400 else text[:397] + "..."
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run one command. Exit codes: 0 done; 2 bad input (an option, a file, the model), one line naming it;
+    1 a run that failed, one line; 130 interrupted (Ctrl-C), one line saying how to resume. A traceback
+    only with --debug or DRAKE_BIPED_DEBUG=1."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    debug = bool(getattr(args, "debug", False)) or os.environ.get(DEBUG_ENV, "") not in ("", "0")
+    prefix = f"drake-biped {args.command}"
     try:
         return args.func(args)
-    except ParameterError as exc:
-        parser.exit(2, f"drake-biped {args.command}: error: {exc}\n")
+    except KeyboardInterrupt:
+        if debug:
+            raise
+        out = getattr(args, "out", None)
+        again = ("run the same command again to resume: finished work is kept in " + str(out)
+                 if args.command in RESUMABLE and out else "run the same command again")
+        _exit(130, f"{prefix}: interrupted; {again}")
+    except (ParameterError, ModelError) as exc:
+        _remove_empty_made_folders()
+        if debug:
+            raise
+        _exit(2, f"{prefix}: error: {_one_line(exc)}")
+    except Exception as exc:  # a failed run: one line, the traceback on request
+        if debug:
+            raise
+        _exit(1, f"{prefix}: failed: {type(exc).__name__}: {_one_line(exc)} (rerun with --debug for the traceback)")
     return 0
+
+
+def _remove_empty_made_folders() -> None:
+    for folder in reversed(_MADE):
+        try:
+            folder.rmdir()  # only an empty folder goes
+        except OSError:
+            pass
+    _MADE.clear()
+
+
+def _exit(code: int, message: str) -> None:
+    sys.stderr.flush()
+    print(message, file=sys.stderr, flush=True)
+    raise SystemExit(code)
 
 
 if __name__ == "__main__":

@@ -98,17 +98,27 @@ class _Validated:
         return dataclasses.asdict(self)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any] | None):
-        data = dict(data or {})
+    def from_dict(cls, data: dict[str, Any] | None, where: str | None = None):
+        """An instance from a mapping of its fields (a JSON object); ParameterError naming `where` (default:
+        the class) for anything else, an unknown field or a bad value."""
+        where = where or cls.__name__
+        if data is None:
+            data = {}
+        if not isinstance(data, Mapping):
+            shown = repr(data) if len(repr(data)) <= 60 else repr(data)[:57] + "..."
+            raise ParameterError(f"{where}: expected a mapping of {cls.__name__} fields, got {type(data).__name__} "
+                                 f"{shown}")
+        data = dict(data)
         known = {f.name: f for f in fields(cls)}
         unknown = sorted(set(data) - set(known))
         if unknown:
-            raise ParameterError(f"{cls.__name__}: unknown parameter(s) {unknown}; known: {sorted(known)}")
+            raise ParameterError(f"{where}: unknown parameter(s) {unknown}; known: {sorted(known)}")
         kwargs = {}
         for name, value in data.items():
             sub = _SECTIONS.get(name) if cls is EpisodeConfig else None
             if sub is not None:
-                kwargs[name] = None if value is None else sub.from_dict(value)
+                inner = f"{where}.{name}" if where == cls.__name__ else f"{where}, section {name!r}"
+                kwargs[name] = None if value is None else sub.from_dict(value, inner)
             else:
                 kwargs[name] = value
         return cls(**kwargs)
@@ -360,6 +370,9 @@ class EpisodeConfig(_Validated):
         super().__post_init__()
         if self.seed < 0:
             raise ParameterError(f"EpisodeConfig.seed must be a non-negative integer, got {self.seed!r}")
+        if self.push is not None and self.push.force_n != 0.0 and self.push.start_s >= self.sim.max_time_s:
+            raise ParameterError(f"Push.start_s = {self.push.start_s!r} is at or after the time limit "
+                                 f"sim.max_time_s = {self.sim.max_time_s!r}: the push would never act")
 
     def replace(self, **changes: Any) -> EpisodeConfig:
         """A copy with whole sections (or the seed) replaced: `config.replace(window=TorqueFreeWindow(0.2, 0.5))`."""

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 from typing import Any
 
 from drake_biped.params import ParameterError
 
-__all__ = ["read_json", "write_atomic", "write_text_atomic"]
+__all__ = ["read_json", "read_kept", "set_aside", "warn", "write_atomic", "write_text_atomic"]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -37,3 +38,35 @@ def read_json(path: Path, what: str) -> Any:
         return json.loads(path.read_text())
     except json.JSONDecodeError as exc:
         raise ParameterError(f"{what} {path}: not valid JSON ({exc})") from None
+
+
+def warn(message: str) -> None:
+    """A one-line warning on standard error."""
+    print(f"drake-biped: warning: {message}", file=sys.stderr, flush=True)
+
+
+def set_aside(path: Path, why: str) -> Path:
+    """Rename a damaged file to PATH.broken (PATH.broken-2, ... when taken), say so, and return the new name:
+    nothing is deleted."""
+    path = Path(path)
+    target = path.with_name(path.name + ".broken")
+    k = 2
+    while target.exists():
+        target = path.with_name(f"{path.name}.broken-{k}")
+        k += 1
+    os.replace(path, target)
+    warn(f"{path} {why}; kept as {target.name}")
+    return target
+
+
+def read_kept(path: Path) -> Any | None:
+    """A kept result that can be recomputed (one episode, an experiment's summary): its JSON, or None when
+    the file is missing, or damaged (then set aside as PATH.broken, with a warning, and recomputed)."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        return json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        set_aside(path, "is not valid JSON (a damaged result); it is computed again")
+        return None

@@ -66,4 +66,4 @@ def load_gait(value: str | Path) -> EpisodeConfig:
     data = read_json(path, "--params")
     if isinstance(data, dict) and "config" in data:
         data = data["config"]
-    return EpisodeConfig.from_dict(data)
+    return EpisodeConfig.from_dict(data, f"--params {path}")

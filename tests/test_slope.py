@@ -84,7 +84,7 @@ def test_start_from_learning_takes_the_best_trials_learner_state(tmp_path):
 
 
 @pytest.mark.parametrize("argv, match", [
-    (["slope", "--episodes", "2"], "--slope is required"),
+    (["slope", "--episodes", "2"], "required: --slope"),
     (["slope", "--slope", "-0.02"], "must be > 0"),
     (["slope", "--slope", "0.02", "--policy", "x.json", "--t1", "0.1", "--t2", "0.3"], "either --policy"),
     (["slope", "--slope", "0.02", "--policy", "none.json"], "no such file"),

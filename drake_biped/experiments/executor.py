@@ -12,7 +12,9 @@ import logging
 import os
 import re
 import resource
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -20,6 +22,7 @@ from typing import Any
 
 from drake_biped.params import ParameterError
 
+SCHEDULER_TIMEOUT = "10s"
 _ADDRESS = re.compile(r"^(tcp|tls|inproc|ucx)://[^\s/]+(:\d+)?$")
 
 
@@ -47,13 +50,18 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     The local cluster binds to 127.0.0.1 only, runs one thread per worker (Drake episodes are CPU-bound
     and hold the GIL), and has no dashboard. Defaults to one worker per core.
     """
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     logging.getLogger("distributed").setLevel(logging.WARNING)
     if scheduler is not None:
         if workers is not None:
             raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
-        client = Client(check_scheduler_address(scheduler), timeout="20s")
+        try:
+            client = Client(check_scheduler_address(scheduler), timeout=SCHEDULER_TIMEOUT)
+        except (OSError, TimeoutError) as exc:
+            raise ParameterError(f"--scheduler {scheduler}: no Dask scheduler answered within "
+                                 f"{SCHEDULER_TIMEOUT} ({type(exc).__name__}); start one (dask scheduler) or "
+                                 "check the address") from None
         try:
             yield client
         finally:
@@ -62,7 +70,35 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
     n = workers or max(1, os.cpu_count() or 1)
-    cluster = LocalCluster(
+    with _workers_ignore_ctrl_c():
+        cluster = _local_cluster(n)
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+@contextmanager
+def _workers_ignore_ctrl_c() -> Iterator[None]:
+    """Worker processes started inside this block ignore SIGINT (they inherit its disposition), so Ctrl-C
+    reaches the driver alone: it stops the run, closes the cluster and says how to resume, while the workers
+    print no tracebacks of their own."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _local_cluster(n: int):
+    from distributed import LocalCluster
+
+    return LocalCluster(
         n_workers=n,
         threads_per_worker=1,
         processes=True,
@@ -73,12 +109,6 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
         scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
         silence_logs=40,
     )
-    client = Client(cluster)
-    try:
-        yield client
-    finally:
-        client.close()
-        cluster.close()
 
 
 def peak_rss_mb() -> float:
@@ -108,17 +138,16 @@ def run_kept(
     """One episode per job {key: (path, EpisodeConfig dict)}, each result kept at its path (atomically):
     a result already there for the same configuration is read back instead of run. Results by key;
     progress(done, total) as they come."""
-    import json
 
     from distributed import as_completed
 
-    from drake_biped.records import write_atomic
+    from drake_biped.records import read_kept, write_atomic
 
     results: dict[Any, dict[str, Any]] = {}
     todo = {}
     for key, (path, config) in jobs.items():
-        if path.is_file():
-            saved = json.loads(path.read_text())
+        saved = read_kept(path)
+        if isinstance(saved, dict):
             if saved.get("config") == config:
                 results[key] = saved
                 continue

@@ -172,9 +172,10 @@ def _read_log(path: Path) -> list[dict]:
     for i, line in enumerate(lines):
         try:
             records.append(json.loads(line))
-        except json.JSONDecodeError:
+        except json.JSONDecodeError as exc:
             if i != len(lines) - 1:
-                raise
+                raise ParameterError(f"{path}, line {i + 1}: not valid JSON ({exc}); only a last line cut short "
+                                     "by a kill is dropped: repair or delete that line to resume") from None
             path.write_text("".join(json.dumps(r) + "\n" for r in records))
     return records
 

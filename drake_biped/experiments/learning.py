@@ -78,7 +78,7 @@ class Trial:
         self.config = EpisodeConfig.from_dict(settings["config"])
         start = settings["learner"].get("start_state")
         if self.path.is_file():
-            record = json.loads(self.path.read_text())
+            record = self._read_record()
             if _fixed(record.get("settings", {})) != _fixed(settings):
                 raise ParameterError(
                     f"{self.path} was made with other settings (seed, episodes' config or learner); "
@@ -95,6 +95,20 @@ class Trial:
             self.learner = GarbLearner(ls["mean"], ls["variance"], ls["beta"], [tuple(b) for b in ls["schedule"]],
                                        seed=trial_seed(settings["seed"], index))
         self.pending: np.ndarray | None = None
+
+    def _read_record(self) -> dict[str, Any]:
+        """The trial's record, or ParameterError naming the file and what to do: it is never overwritten."""
+        remedy = (f"restore it, or delete it to run trial {self.index} again from its first episode (the same "
+                  "seed gives the same episodes; the other trials are kept)")
+        try:
+            record = json.loads(self.path.read_text())
+            GarbLearner.from_state(record["learner"])
+            record["episodes"][:0]
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise ParameterError(f"{self.path}: not valid JSON ({exc}); {remedy}") from None
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ParameterError(f"{self.path}: not a trial record ({type(exc).__name__}: {exc}); {remedy}") from None
+        return record
 
     @property
     def done(self) -> int:

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from drake_biped.records import write_atomic
+from drake_biped.records import set_aside, write_atomic
 
 __all__ = ["RunProgress", "SessionLog"]
 
@@ -16,22 +16,45 @@ __all__ = ["RunProgress", "SessionLog"]
 class SessionLog:
     """OUT/run.json: one entry per session of a run (a first run and each resume): when, on what, how many
     episodes in how long. Rewritten at most every `every_s` seconds while running, so a session that is
-    killed keeps its numbers. Wall times live here, not in learning.json, which a resume reproduces."""
+    killed keeps its numbers, and the next session counts any finished episode the log missed (`reconcile`).
+    Wall times live here, not in learning.json, which a resume reproduces. An unreadable log is set aside as
+    run.json.broken (with a warning), never dropped."""
 
     def __init__(self, path: Path, workers: int | None, scheduler: str | None, every_s: float = 10.0):
         self.path = path
         self.sessions: list[dict[str, Any]] = []
         if path.is_file():
             try:
-                self.sessions = list(json.loads(path.read_text()).get("sessions", []))
-            except (json.JSONDecodeError, AttributeError):
-                pass  # an unreadable log starts afresh; learning.json and the trials are not affected
+                sessions = json.loads(path.read_text())["sessions"]
+                if not (isinstance(sessions, list) and all(isinstance(x, dict) for x in sessions)):
+                    raise TypeError("sessions is not a list of sessions")
+                self.sessions = sessions
+            except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError):
+                set_aside(path, "is not a readable run log: a new session history starts (the run's results "
+                          "are not affected)")
         self.t0 = time.perf_counter()
         self.every_s = every_s
         self._last = -math.inf
+        self.written: int | None = None  # the count of this session the file holds
         self.current = {"started": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "workers": workers,
                         "scheduler": scheduler, "episodes": 0, "learning_wall_s": 0.0, "wall_s": 0.0,
                         "episodes_per_min": None, "finished": False}
+
+    def reconcile(self, done: int) -> None:
+        """`done` units are finished in the run's records when this session starts: count those that no
+        logged session counts (a session killed between two writes of the log, or a lost log) in the last
+        unfinished session, or else in an entry of their own."""
+        missing = done - sum(int(x.get("episodes", 0)) for x in self.sessions)
+        if missing <= 0:
+            return
+        last = self.sessions[-1] if self.sessions else None
+        if last is not None and not last.get("finished", False):
+            last["episodes"] = int(last.get("episodes", 0)) + missing
+            last["counted_from_records"] = missing
+        else:
+            self.sessions.append({"started": None, "workers": None, "scheduler": None, "episodes": missing,
+                                  "learning_wall_s": 0.0, "wall_s": 0.0, "episodes_per_min": None,
+                                  "finished": False, "counted_from_records": missing})
 
     def update(self, episodes: int, learning: bool = True, finished: bool = False, force: bool = False) -> None:
         now = time.perf_counter() - self.t0
@@ -43,6 +66,7 @@ class SessionLog:
         self.current["finished"] = finished
         if force or finished or now - self._last >= self.every_s:
             self._last = now
+            self.written = episodes
             done = [*self.sessions, self.current]
             episodes_all = sum(s["episodes"] for s in done)
             wall_all = sum(s["learning_wall_s"] for s in done)
@@ -70,6 +94,7 @@ class RunProgress:
     def __call__(self, done: int, total: int, latest: float | None = None) -> None:
         if self.first is None:
             self.first = done
+            self.log.reconcile(done)
         self.done = done
         self.log.update(done - self.first)
         if self.bar is not None:
@@ -85,5 +110,9 @@ class RunProgress:
         return 0 if self.first is None else self.done - self.first
 
     def close(self) -> None:
+        """Close the bar; write the log if it misses units finished since its last write (a run stopped by
+        Ctrl-C or an error between two writes)."""
         if self.bar is not None:
             self.bar.close()
+        if self.log.written != self.new:
+            self.log.update(self.new, force=True)

@@ -36,7 +36,7 @@ from typing import Any
 
 from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import PAPER_CPG, EpisodeConfig, InitialConditions, ParameterError, TorqueFreeWindow
-from drake_biped.records import write_atomic
+from drake_biped.records import read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
@@ -103,8 +103,8 @@ class Reproduction:
         """fn(folder) -> summary, unless DIR/name/summary.json holds one made with these settings."""
         folder = self.out / name
         path = folder / "summary.json"
-        if path.is_file():
-            saved = json.loads(path.read_text())
+        saved = read_kept(path)
+        if isinstance(saved, dict):
             if saved.get("settings") == settings:
                 self.log(f"[{name}] finished earlier: reused")
                 return saved
@@ -338,8 +338,9 @@ def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = Tr
 def check_out(out: Path, profile: Profile) -> None:
     """Refuse an output folder that holds another profile's run (its records would refuse to resume)."""
     marker = out / "profile.json"
-    if marker.is_file():
-        saved = json.loads(marker.read_text()).get("name")
+    kept = read_kept(marker)
+    if isinstance(kept, dict):
+        saved = kept.get("name")
         if saved != profile.name:
             raise ParameterError(f"--out {out} holds a {saved!r} run; use another folder for a {profile.name!r} run")
     out.mkdir(parents=True, exist_ok=True)

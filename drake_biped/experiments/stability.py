@@ -16,7 +16,6 @@ same settings reads them back and runs only what is missing.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -177,7 +176,7 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
     """Run (or finish) the six cells on Dask, then the finite-difference Jacobian of each condition's step
     map at each kick size, and return the stability record. Finished parts are read back on a rerun."""
     from drake_biped.experiments.executor import run_kept
-    from drake_biped.records import write_atomic
+    from drake_biped.records import read_kept, write_atomic
 
     code = versions()  # recorded at the start: the code this process runs
     (out / "episodes").mkdir(parents=True, exist_ok=True)
@@ -191,8 +190,8 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
         jacobian[condition] = []
         for size in jacobian_kicks:
             path = out / "episodes" / f"jacobian_{condition}_{size:g}.json"
-            if path.is_file():
-                saved = json.loads(path.read_text())
+            saved = read_kept(path)
+            if isinstance(saved, dict):
                 if saved.get("config") == config.to_dict():
                     jacobian[condition].append(saved["jacobian"])
                     continue

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams, TorqueFreeWindow
-from drake_biped.records import write_text_atomic
+from drake_biped.records import read_json, write_text_atomic
 from drake_biped.versions import versions
 
 WALKS = [None, (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7)]
@@ -197,7 +197,7 @@ def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = Tru
 
 def replot(out: Path) -> dict:
     """Redraw the Markdown and the figure from out/time_step_study.json."""
-    rec = json.loads((out / "time_step_study.json").read_text())
+    rec = read_json(out / "time_step_study.json", "--replot")
     write_text_atomic(out / "time_step_study.md", markdown(rec))
     figure(rec, out / "time_step_study.png")
     return rec

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from drake_biped.params import EpisodeConfig, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
@@ -31,6 +31,11 @@ class WindowMapSettings:
     t1_step_s: float = 0.1
     t2_step_s: float = 0.1
     min_length_s: float = 0.1
+
+    def __post_init__(self) -> None:
+        if not self.windows():
+            raise ParameterError(f"--t1-max {self.t1_max_s:g} --t2-max {self.t2_max_s:g} --step {self.t1_step_s:g}: "
+                                 f"no window fits (t2 runs from t1 + {self.min_length_s:g} s up to --t2-max)")
 
     def windows(self) -> list[tuple[float, float]]:
         return window_grid(self.t1_max_s, self.t2_max_s, self.t1_step_s, self.t2_step_s, self.min_length_s)
