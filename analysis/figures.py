@@ -42,21 +42,22 @@ def walk_figure(trajectory: dict, path: str | Path, title: str = "") -> None:
     q = trajectory["positions"]
     tau = trajectory["actuation"]
     work = trajectory["positive_work"]
-    fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
+    fig, axes = plt.subplots(3, 1, figsize=(11.5, 9), sharex=True)
     ax = axes[0]
     for j, name in enumerate(JOINTS):
         side = name.split("_")[0]
         style = {"hip": "-", "knee": "--", "ankle": ":"}[name.split("_")[1]]
         ax.plot(t, np.degrees(q[:, 3 + j]), style, color=COLORS[side], lw=1, label=name)
     ax.set_ylabel("joint angle [deg]")
-    ax.legend(ncol=6, fontsize=7, loc="upper right")
+    # Legends beside the axes, where they cover no trace.
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax = axes[1]
     for side, j in (("left", 0), ("right", 3)):
         ax.plot(t, tau[:, j], color=COLORS[side], lw=1, label=f"{side} hip torque")
     for k, (a, b) in enumerate(_spans(t, trajectory["torque_free"])):
         ax.axvspan(a, b, color="0.8", lw=0, label="torque-free (swing hip)" if k == 0 else None)
     ax.set_ylabel("hip torque [N m]")
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax = axes[2]
     for j, name in enumerate(JOINTS):
         side = name.split("_")[0]
@@ -65,7 +66,7 @@ def walk_figure(trajectory: dict, path: str | Path, title: str = "") -> None:
     ax.plot(t, work.sum(axis=1), "k-", lw=1.5, label="total")
     ax.set_ylabel("cumulative positive work [J]")
     ax.set_xlabel("time [s]")
-    ax.legend(ncol=4, fontsize=7, loc="upper left")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
@@ -296,6 +297,11 @@ def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, p
 
     pairs = [(a, b) for i, a in enumerate(varying) for b in varying[i + 1 :]]
     short = {a.name: a.name.split(".")[-1] for a in axes}
+    # The colour scale spans the distances walked (up to the target), so that a grid in which every point
+    # falls early still shows which fell later.
+    walked = [r["distance_m"] for r in rows if np.isfinite(r["distance_m"])]
+    top = min(distance_m, max(walked, default=distance_m)) if walked else distance_m
+    top = top if top > 0 else distance_m
     if not pairs:
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         if varying:
@@ -312,7 +318,7 @@ def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, p
         image = None
         for ax, (a, b) in zip(grid.flat, pairs):
             z = np.array([[distance({a.name: va, b.name: vb}) for va in a.values] for vb in b.values])
-            image = ax.imshow(z, origin="lower", aspect="auto", vmin=0, vmax=distance_m, cmap="viridis")
+            image = ax.imshow(z, origin="lower", aspect="auto", vmin=0, vmax=top, cmap="viridis")
             ax.set_xticks(range(len(a.values)), [f"{v:.3g}" for v in a.values], fontsize=7)
             ax.set_yticks(range(len(b.values)), [f"{v:.3g}" for v in b.values], fontsize=7)
             ax.set_xlabel(short[a.name], fontsize=8)
@@ -320,7 +326,9 @@ def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, p
             ax.plot(a.values.index(best[a.name]), b.values.index(best[b.name]), "r*", ms=9)
         for ax in list(grid.flat)[len(pairs):]:
             ax.axis("off")
-        fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.9, label="walking distance (m)")
+        label = "walking distance (m)" + ("" if top >= distance_m else f"; the furthest walk, {top:.2f} m, is the top "
+                                                                   f"(target {distance_m:g} m)")
+        fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.9, label=label)
     fixed = ", ".join(f"{short[a.name]}={best[a.name]:.3g}" for a in axes)
     fig.suptitle(f"Grid search: distance walked, slices through the best point (red star: {fixed})", fontsize=9)
     fig.savefig(path, dpi=110)

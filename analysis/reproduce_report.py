@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.series import signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
 
@@ -23,7 +24,7 @@ REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
 def _pct(x: float | None) -> str:
     if x is None:
         return "—"
-    return "0.0 %" if abs(x) < 5e-4 else f"{100 * x:+.1f} %"
+    return signed_percent(x)
 
 
 def _num(x: float | None, digits: int = 3) -> str:
@@ -83,6 +84,12 @@ def stability_verdict(cells: dict[str, Any]) -> tuple[str, str]:
     diffs = [abs(cell["spectral_radius"] - cell["paper_spectral_radius"]) for *_, cell in flat
              if cell["spectral_radius"] is not None]
     ours = f"{stable} of 6 cells stable; ρ differs from the paper's by up to {max(diffs, default=0):.2f}"
+    crossing = sum(1 for *_, cell in flat if cell["stable"] and cell.get("spectral_radius_ci")
+                   and cell["spectral_radius_ci"][1] >= 1.0)
+    if crossing:
+        ours += f" ({crossing} of them with a 95 % interval of ρ reaching above 1)"
+    if stable == 6 and crossing:
+        return ours, f"{PARTLY}: all stable by their fits, {crossing} not established; eigenvalues: {DIFFERS}"
     if stable == 6:
         return ours, f"{REPRODUCED} (all stable); eigenvalues: {DIFFERS}"
     return ours, f"{NOT_REPRODUCED}: {6 - stable} cell(s) not stable"

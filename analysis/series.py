@@ -23,3 +23,14 @@ def period(t1: float, t2: float) -> float:
     """Length of the torque-free period a (t1, t2) sample or mean gives: t2 - t1 with times below 0 acting
     as 0, and 0 when t2 <= t1."""
     return float(max(0.0, max(0.0, t2) - max(0.0, t1)))
+
+
+def signed_percent(fraction: float | None, digits: int = 1) -> str:
+    """A fraction as a signed percentage ("+12.3 %", "-4.0 %"); one that rounds to zero prints "0.0 %", never
+    "-0.0 %"; None prints "—"."""
+    if fraction is None:
+        return "—"
+    value = round(100.0 * fraction, digits)
+    if value == 0:
+        return f"{0:.{digits}f} %"
+    return f"{value:+.{digits}f} %"

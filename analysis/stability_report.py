@@ -18,6 +18,11 @@ STEP_COLOURS = ("red", "green", "purple", "blue", "black")
 CONDITION_NAMES = {"without": "without torque-free period", "with": "with torque-free period"}
 
 
+def markdown_cell(text: str) -> str:
+    """A table cell's text with its pipes escaped, so that it cannot split the Markdown table."""
+    return str(text).replace("|", "\\|")
+
+
 def _eig_text(pairs) -> str:
     out = []
     for re, im in pairs:
@@ -77,6 +82,9 @@ def _verdict(cell: dict) -> str:
         return ("not stable: " + falls + "; no fit") if cell["falls"] else "no fit: " + cell["error"]
     if cell["falls"]:
         return f"not stable: {falls} (ρ {cell['spectral_radius']:.2f} over their touchdowns before the fall)"
+    ci = cell.get("spectral_radius_ci")
+    if cell["stable"] and ci and ci[1] >= 1.0:
+        return f"stable by its fit (ρ < 1), but not established: the 95 % interval of ρ reaches {ci[1]:.2f}"
     return "stable (ρ < 1)" if cell["stable"] else "unstable (ρ ≥ 1)"
 
 
@@ -102,7 +110,7 @@ def _rows(record: dict) -> list[dict]:
     return rows
 
 
-COLUMNS = (("cell", "cell"), ("paper", "paper λ"), ("paper_rho", "paper |λ|max"), ("ours", "ours λ"),
+COLUMNS = (("cell", "cell"), ("paper", "paper λ"), ("paper_rho", "paper ρ"), ("ours", "ours λ"),
            ("rho", "ours ρ"), ("ci", "95 % CI of ρ"), ("pairs", "pairs"), ("falls", "falls"),
            ("verdict", "verdict"))
 
@@ -145,18 +153,19 @@ def report_markdown(record: dict) -> str:
         "",
         _intro(record),
         "",
-        "| " + " | ".join(h for _, h in COLUMNS) + " |",
+        "| " + " | ".join(markdown_cell(h) for _, h in COLUMNS) + " |",
         "|" + "---|" * len(COLUMNS),
     ]
     for row in _rows(record):
-        lines.append("| " + " | ".join(row[k] for k, _ in COLUMNS) + " |")
-    lines += ["", "A cell is stable when the spectral radius ρ of its fitted return map is below 1 and no trial "
-              "fell; every cell of the paper's Table VI is. ![Fig. 7](fig7_return_map.png)", ""]
+        lines.append("| " + " | ".join(markdown_cell(row[k]) for k, _ in COLUMNS) + " |")
+    lines += ["", "ρ is the spectral radius, the largest |λ|. A cell is stable when the ρ of its fitted return map "
+              "is below 1 and no trial fell (and established when the upper end of its 95 % interval is below 1 "
+              "too); every cell of the paper's Table VI is stable. ![Fig. 7](fig7_return_map.png)", ""]
     jac_rows = _jacobian_rows(record)
     if jac_rows:
         lines += [f"## {JACOBIAN_TITLE}", "", JACOBIAN_TEXT, "", "| " + " | ".join(JACOBIAN_COLUMNS) + " |",
                   "|" + "---|" * len(JACOBIAN_COLUMNS)]
-        lines += ["| " + " | ".join(row) + " |" for row in jac_rows]
+        lines += ["| " + " | ".join(markdown_cell(c) for c in row) + " |" for row in jac_rows]
         lines.append("")
     v = record.get("versions", {})
     lines.append(f"drake-biped {v.get('drake_biped', '?')} ({v.get('git_commit', '?')}), Drake {v.get('drake', '?')}.")

@@ -463,7 +463,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 
-    ts = sub.add_parser("time-step-study", help="C_mt, speed and step period against the time step; the default")
+    ts = sub.add_parser("time-step-study", help="C_mt, speed and step period against the time step, and the default step they choose")
     ts.add_argument("--steps", type=_steps, default=[0.00025, 0.0005, 0.001, 0.002, 0.005],
                     help="time steps (s), comma-separated (default 0.00025,0.0005,0.001,0.002,0.005)")
     ts.add_argument("--reference", type=_number("positive"), default=0.0005, help="reference step (s), one of --steps")

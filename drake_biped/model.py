@@ -129,6 +129,17 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
         X = RigidTransform(rotation, [centre_x + offset[0], 0.0, centre_z + offset[2]])
         plant.RegisterVisualGeometry(world, X, Box(length, 1.0, 0.02), name, np.array([0.45, 0.6, 0.45, 1.0]))
 
+    def add_marks(x0: float, x1: float) -> None:
+        # A dark line across the ground every metre (visual only): the walk's progress shows in the
+        # recording, whose camera moves with the robot.
+        for k in range(math.ceil(x0), math.floor(x1) + 1):
+            z = ground.height(float(k))
+            angle = ground.slope_at(float(k))
+            X = RigidTransform(RotationMatrix.MakeYRotation(-angle), [float(k), 0.0, z + 0.0005])
+            plant.RegisterVisualGeometry(world, X, Box(0.015, 1.0, 0.001), f"ground_mark_{k}",
+                                         np.array([0.25, 0.35, 0.25, 1.0]))
+
+    add_marks(-2.0, 60.0)
     if ground.level_length_m is None:
         add_plane("ground", ground.slope_rad, 0.0)
         add_visual("ground_visual", ground.slope_rad, -5.0, 60.0, -5.0 * math.tan(ground.slope_rad))

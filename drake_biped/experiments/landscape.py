@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.landscape import WindowRewards, landscape
+from drake_biped.analysis.series import signed_percent
 from drake_biped.params import ParameterError
 from drake_biped.records import write_atomic
 from drake_biped.versions import versions
@@ -58,6 +59,6 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     for cell in record["variances"]:
         s = cell["starts"][0]
         lines.append(f"variance {cell['variance']:g}: best policy mean ({cell['best_mean'][0]:.3f}, "
-                     f"{cell['best_mean'][1]:.3f}) expected reward {100 * cell['best_gain']:+.1f} % vs no window; "
-                     f"at the start {tuple(s['mean'])} {100 * s['gain']:+.1f} %")
+                     f"{cell['best_mean'][1]:.3f}) expected reward {signed_percent(cell['best_gain'])} vs no window; "
+                     f"at the start {tuple(s['mean'])} {signed_percent(s['gain'])}")
     return lines

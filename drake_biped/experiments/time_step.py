@@ -14,6 +14,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams, TorqueFreeWindow
 from drake_biped.records import read_json, write_text_atomic
@@ -100,7 +101,7 @@ def markdown(rec: dict) -> str:
             return f"fell at {r['distance_m']:.1f} m"
         dev = r["cmt_deviation"]
         mark = "" if dev is None or abs(dev) <= rec["tolerance"] else " ✗"
-        return f"{r['cost_of_transport']:.4f} ({100 * dev:+.1f} %){mark}" if dev is not None else f"{r['cost_of_transport']:.4f}"
+        return f"{r['cost_of_transport']:.4f} ({signed_percent(dev)}){mark}" if dev is not None else f"{r['cost_of_transport']:.4f}"
 
     chosen = rec["chosen_step_s"]
     lines = [

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
 from drake_biped.params import EpisodeConfig
@@ -49,17 +50,38 @@ def start_meshcat():
     return Meshcat(params)
 
 
-def write_meshcat_html(meshcat, path: Path, x_range: tuple[float, float] | None = None) -> None:
+# The recording's camera: this far in front of the walker's sagittal plane (m), this high, looking at the hip
+# height: the robot fills about a third of the window's height.
+CAMERA_DISTANCE_M = 2.2
+CAMERA_HEIGHT_M = 0.55
+CAMERA_TARGET_Z_M = 0.45
+
+
+def write_meshcat_html(meshcat, path: Path, follow: tuple[np.ndarray, np.ndarray] | None = None,
+                       ground_height=None) -> None:
     """Publish the recording and save Meshcat's self-contained HTML page.
 
-    x_range: the stretch of ground the walk covered (m); the camera looks at it from the side, so the
-    whole walk is in view (press play under "Open Controls" > Animations to watch it)."""
+    follow: (times (s), x (m)) of the walker. The camera then looks at it from the side while the scene (the
+    robot and its ground) is shifted back by the walker's progress in every frame of the recording, as on a
+    treadmill: the robot stays in view at a readable size over the whole walk, whatever its length (press
+    play under "Open Controls" > Animations to replay it; the fixed grid is hidden, the ground moves).
+    ground_height(x): the ground's height under the walker (default level)."""
+    if follow is not None:
+        times, xs = (np.asarray(a, dtype=float) for a in follow)
+        recording = meshcat.get_mutable_recording()
+        fps = recording.frames_per_second()
+        z_of = ground_height or (lambda x: 0.0)
+        for frame in range(int(np.floor(times[-1] * fps)) + 1):
+            x = float(np.interp(frame / fps, times, xs))
+            recording.SetTransform(frame, "/drake", RigidTransform([-x, 0.0, -z_of(x)]))
+        x0 = float(xs[0])
+        meshcat.SetTransform("/drake", RigidTransform([-x0, 0.0, -z_of(x0)]))
+        meshcat.SetProperty("/Grid", "visible", False)
+        meshcat.SetProperty("/Axes", "visible", False)
+        meshcat.SetCameraPose(np.array([0.0, -CAMERA_DISTANCE_M, CAMERA_HEIGHT_M]),
+                              np.array([0.0, 0.0, CAMERA_TARGET_Z_M]))
     meshcat.StopRecording()
     meshcat.PublishRecording()
-    if x_range is not None:
-        x_mid = 0.5 * (x_range[0] + x_range[1])
-        distance = 0.65 * abs(x_range[1] - x_range[0]) + 2.0
-        meshcat.SetCameraPose(np.array([x_mid, -distance, 0.9]), np.array([x_mid, 0.0, 0.35]))
     Path(path).write_text(meshcat.StaticHtml())
 
 
@@ -143,8 +165,9 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
     ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
     walk_figure(result.trajectory, out / "walk.png", title=title)
     if meshcat is not None:
-        x = result.trajectory["positions"][:, 0]
-        write_meshcat_html(meshcat, out / "walk.html", x_range=(float(x.min()), float(x.max())))
+        write_meshcat_html(meshcat, out / "walk.html", follow=(result.trajectory["time"],
+                                                             result.trajectory["positions"][:, 0]),
+                           ground_height=config.ground.height)
         walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
     return result
 

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.series import signed_percent
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
@@ -129,5 +130,5 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
              f"{len(walked)}/{len(rows)} windows walk {record['config']['sim']['distance_m']:g} m"]
     if best is not None:
         lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
-                     f"({100 * (best['cmt_change'] or 0):+.1f}% vs no window)")
+                     f"({signed_percent(best['cmt_change'])} vs no window)")
     return lines
