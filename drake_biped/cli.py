@@ -221,6 +221,7 @@ def cmd_learn(args: argparse.Namespace) -> int:
                                          mean=tuple(args.initial_mean), variance=args.variance)
     record_settings = settings.record()  # validated before a cluster starts
     out = Path(args.out)
+    learning.check_resume(record_settings, out)
     with _client(args) as client:
         record = learning.run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler)
     _print(learning.summary_lines(record, out))

@@ -311,6 +311,13 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
     return record
 
 
+def check_resume(settings: dict[str, Any], out: Path) -> None:
+    """Read every trial record a rerun into `out` would resume (ParameterError naming a damaged one or one
+    made with other settings), before any cluster is started."""
+    for k in range(settings["trials"]):
+        Trial(Path(out), k, settings)
+
+
 def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     """What `drake-biped learn` prints after a run: Table V, the reduction, the run's speed."""
     ev = record["evaluation"]

@@ -84,10 +84,7 @@ class RunProgress:
         out.mkdir(parents=True, exist_ok=True)
         self.log = SessionLog(out / "run.json", workers, scheduler)
         self.bar = None
-        if bar:
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=0, desc=desc, unit=unit)
+        self._bar_args = (desc, unit) if bar else None  # the bar starts with the first report
         self.first: int | None = None
         self.done = 0
 
@@ -97,6 +94,10 @@ class RunProgress:
             self.log.reconcile(done)
         self.done = done
         self.log.update(done - self.first)
+        if self.bar is None and self._bar_args is not None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, initial=done, desc=self._bar_args[0], unit=self._bar_args[1])
         if self.bar is not None:
             self.bar.total = total
             self.bar.n = done

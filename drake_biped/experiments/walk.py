@@ -97,15 +97,17 @@ class WalkSettings:
 def run(settings: WalkSettings, out: Path, client=None, progress: bool = True):
     """Walk one episode (in this process: Meshcat records it; `client` is not used) and write its files into
     `out` (see `write_walk`), with a progress bar in metres. The EpisodeResult."""
-    update, bar = None, None
+    update, bars = None, []
     if progress:
         from tqdm import tqdm
 
         total = settings.config.sim.distance_m
-        bar = tqdm(total=round(total, 2), desc="walk", unit="m",
-                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} m [{elapsed}<{remaining}{postfix}]")
 
         def update(t: float, d: float) -> None:
+            if not bars:  # the bar starts with the walk, once the model is built
+                bars.append(tqdm(total=round(total, 2), desc="walk", unit="m",
+                                 bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} m [{elapsed}<{remaining}{postfix}]"))
+            bar = bars[0]
             bar.n = round(min(max(d, 0.0), total), 2)
             bar.set_postfix_str(f"t={t:.1f}s", refresh=False)
             bar.refresh()
@@ -114,7 +116,7 @@ def run(settings: WalkSettings, out: Path, client=None, progress: bool = True):
         return write_walk(settings.config, out, animation=settings.animation,
                           save_trajectory=settings.save_trajectory, progress=update)
     finally:
-        if bar is not None:
+        for bar in bars:
             bar.close()
 
 

@@ -1,0 +1,228 @@
+"""Every failure is one line: bad input exits 2 naming the option, file or value; a failed run exits 1; Ctrl-C
+exits 130 saying how to resume; no traceback unless asked for; nothing already on disk is lost."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from drake_biped.cli import main
+
+
+def run_cli(capsys, argv):
+    """(exit code, stderr lines) of one command run in this process."""
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    err = capsys.readouterr().err
+    return stop.value.code, [line for line in err.splitlines() if line.strip()]
+
+
+def one_line(lines, *expected):
+    assert len(lines) == 1, lines
+    assert "Traceback" not in lines[0]
+    for text in expected:
+        assert text in lines[0], (text, lines[0])
+    return lines[0]
+
+
+@pytest.fixture()
+def files(tmp_path):
+    """Broken and odd input files."""
+    f = {}
+    for name, text in {"list.json": "[1, 2]", "section.json": '{"cpg": "fast"}', "bad.json": '{"cpg": {',
+                       "unknown.json": '{"cpg": {"u_q": 1}}', "range.json": '{"cpg": {"alpha": 9}}',
+                       "spec_bad.yaml": "axes: [", "spec_axis.yaml": "axes: {nope: {values: [1]}}",
+                       "notamap.json": '{"config": {}}', "a_file": "x"}.items():
+        (tmp_path / name).write_text(text)
+        f[name] = str(tmp_path / name)
+    return f
+
+
+BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
+    (["walk", "--out", ""], ["--out", "empty path"]),
+    (["walk", "--out", "{file:a_file}"], ["--out", "is a file"]),
+    (["walk", "--out", "/proc/no/such/place"], ["--out", "cannot write there"]),
+    (["walk", "--distance", "-1", "--out", "{tmp}/w"], ["--distance", "'-1'"]),
+    (["walk", "--distance", "far", "--out", "{tmp}/w"], ["--distance", "'far'"]),
+    (["walk", "--time-step", "0.5", "--out", "{tmp}/w"], ["time_step_s", "0.5"]),
+    (["walk", "--params", "{tmp}/none.json", "--out", "{tmp}/w"], ["--params", "none.json"]),
+    (["walk", "--params", "{file:list.json}", "--out", "{tmp}/w"], ["--params", "list.json", "got list"]),
+    (["walk", "--params", "{file:section.json}", "--out", "{tmp}/w"], ["section 'cpg'", "got str 'fast'"]),
+    (["walk", "--params", "{file:bad.json}", "--out", "{tmp}/w"], ["bad.json", "not valid JSON"]),
+    (["walk", "--params", "{file:unknown.json}", "--out", "{tmp}/w"], ["unknown parameter", "u_q"]),
+    (["walk", "--params", "{file:range.json}", "--out", "{tmp}/w"], ["CpgParams.alpha = 9.0", "[-2, 2]"]),
+    (["walk", "--params", "climbin", "--out", "{tmp}/w"], ["--params 'climbin'", "climbing"]),
+    (["walk", "--t1", "0.5", "--out", "{tmp}/w"], ["--t1 and --t2"]),
+    (["walk", "--t1", "0.5", "--t2", "0.2", "--out", "{tmp}/w"], ["--t1 0.5 --t2 0.2", "no torque-free window"]),
+    (["walk", "--push", "20", "--push-start", "100", "--out", "{tmp}/w"], ["Push.start_s = 100.0", "never act"]),
+    (["walk", "--push-start", "1", "--out", "{tmp}/w"], ["give --push"]),
+    (["walk", "--slope", "0.5", "--out", "{tmp}/w"], ["slope_rad", "0.5"]),
+    (["walk", "--seed", "-1", "--out", "{tmp}/w"], ["--seed", "'-1'"]),
+    (["walk", "--no-such-option", "--out", "{tmp}/w"], ["unrecognized arguments: --no-such-option"]),
+    (["fly", "--out", "{tmp}/w"], ["invalid choice: 'fly'"]),
+    (["window-map", "--t1-max", "0", "--t2-max", "0.05", "--out", "{tmp}/wm"], ["--t1-max 0 --t2-max 0.05",
+                                                                                  "no window fits"]),
+    (["window-map", "--step", "0", "--out", "{tmp}/wm"], ["--step", "'0'"]),
+    (["grid", "--spec", "{tmp}/none.yaml", "--out", "{tmp}/g"], ["--spec", "none.yaml"]),
+    (["grid", "--spec", "{file:spec_bad.yaml}", "--out", "{tmp}/g"], ["spec_bad.yaml", "not valid YAML"]),
+    (["grid", "--spec", "{file:spec_axis.yaml}", "--out", "{tmp}/g"], ["grid axis 'nope'"]),
+    (["grid", "--spec", "tiny", "--points-per-axis", "2", "--out", "{tmp}/g"], ["either --spec or --points-per-axis"]),
+    (["learn", "--trials", "0", "--out", "{tmp}/l"], ["--trials", "'0'"]),
+    (["learn", "--variance", "0", "--out", "{tmp}/l"], ["--variance", "'0'"]),
+    (["learn", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1", "--out", "{tmp}/l"], ["--workers",
+                                                                                           "--scheduler"]),
+    (["learn", "--scheduler", "localhost", "--out", "{tmp}/l"], ["--scheduler 'localhost'", "tcp://HOST:PORT"]),
+    (["stability", "--t1", "0.5", "--t2", "0.2", "--out", "{tmp}/s"], ["--t1 0.5 --t2 0.2", "t1 < t2"]),
+    (["stability", "--policy", "{tmp}/none.json", "--out", "{tmp}/s"], ["--policy", "none.json"]),
+    (["push-margin", "--tolerance", "0", "--out", "{tmp}/p"], ["--tolerance", "'0'"]),
+    (["slope", "--out", "{tmp}/sl"], ["required: --slope"]),
+    (["slope", "--slope", "-0.1", "--out", "{tmp}/sl"], ["--slope -0.1", "> 0"]),
+    (["slope", "--slope", "0.02", "--policy", "{file:notamap.json}", "--out", "{tmp}/sl"], ["notamap.json",
+                                                                                            "learning record"]),
+    (["landscape", "{tmp}/none"], ["no window map", "none"]),
+    (["landscape", "{file:notamap.json}"], ["notamap.json", "not a window map"]),
+    (["figures", "{tmp}"], ["learning.json"]),
+    (["time-step-study", "--steps", "0.001,0.002", "--reference", "0.003", "--out", "{tmp}/t"],
+     ["--reference 0.003", "one of --steps"]),
+    (["time-step-study", "--replot", "--out", "{tmp}/t"], ["--replot", "time_step_study.json"]),
+    (["gait-search", "--sigma", "-1", "--out", "{tmp}/gs"], ["--sigma", "'-1'"]),
+]
+
+
+@pytest.mark.parametrize("argv, expected", BAD, ids=[" ".join(a[:3]) for a, _ in BAD])
+def test_bad_input_is_one_line_naming_it_with_exit_code_2(tmp_path, files, capsys, argv, expected):
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    argv = [files[a[6:-1]] if a.startswith("{file:") else a for a in argv]
+    before = sorted(p.name for p in tmp_path.iterdir())
+    code, lines = run_cli(capsys, argv)
+    assert code == 2
+    one_line(lines, *expected)
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written, no --out folder left
+
+
+def test_a_broken_model_is_one_line(tmp_path, capsys, monkeypatch):
+    import drake_biped.model as model
+
+    (tmp_path / "package.xml").write_text('<?xml version="1.0"?><package format="2"><name>drake_biped</name>'
+                                          "</package>")
+    (tmp_path / "biped.urdf").write_text("<robot name='x'><link name='a'></robot>")
+    monkeypatch.setattr(model, "model_package_xml", lambda: tmp_path / "package.xml")
+    code, lines = run_cli(capsys, ["walk", "--distance", "0.1", "--no-animation", "--out", str(tmp_path / "w")])
+    assert code == 2
+    one_line(lines, "could not parse the biped model")
+
+
+def test_a_failed_run_is_one_line_with_exit_code_1_and_a_traceback_on_request(tmp_path, capsys, monkeypatch):
+    from drake_biped.experiments import walk
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("the disk is full")
+
+    monkeypatch.setattr(walk, "run", broken)
+    argv = ["walk", "--out", str(tmp_path / "w")]
+    code, lines = run_cli(capsys, argv)
+    assert code == 1
+    one_line(lines, "failed: RuntimeError: the disk is full", "--debug")
+    with pytest.raises(RuntimeError, match="the disk is full"):
+        main([*argv, "--debug"])
+    monkeypatch.setenv("DRAKE_BIPED_DEBUG", "1")
+    with pytest.raises(RuntimeError, match="the disk is full"):
+        main(argv)
+
+
+def _learn(tmp_path, episodes=2):
+    return ["learn", "--trials", "1", "--episodes", str(episodes), "--distance", "0.5", "--workers", "1",
+            "--out", str(tmp_path / "l")]
+
+
+def test_damaged_records_are_named_and_nothing_finished_is_lost(tmp_path, capsys):
+    main(_learn(tmp_path))
+    capsys.readouterr()
+    trial = tmp_path / "l" / "trials" / "trial_0.json"
+    # A damaged run log is set aside with a warning, and the run goes on.
+    (tmp_path / "l" / "run.json").write_text('{"sessions": [{"episo')
+    main(_learn(tmp_path))
+    err = capsys.readouterr().err
+    assert "run.json is not a readable run log" in err and (tmp_path / "l" / "run.json.broken").is_file()
+    # A damaged trial record is refused by name, with what to do, and left as it is.
+    text = trial.read_text()
+    trial.write_text(text[: len(text) // 2])
+    code, lines = run_cli(capsys, _learn(tmp_path, 3))
+    assert code == 2
+    one_line(lines, str(trial), "not valid JSON", "delete it to run trial 0 again")
+    assert trial.read_text() == text[: len(text) // 2]
+
+
+def test_the_run_log_counts_the_episodes_a_killed_session_never_logged(tmp_path, capsys):
+    main(_learn(tmp_path))
+    log = tmp_path / "l" / "run.json"
+    record = json.loads(log.read_text())
+    record["sessions"][0].update(episodes=0, finished=False)  # as a session killed before its first write
+    log.write_text(json.dumps(record))
+    main(_learn(tmp_path, 3))
+    sessions = json.loads(log.read_text())["sessions"]
+    assert [s["episodes"] for s in sessions] == [2, 1]
+    assert sessions[0]["counted_from_records"] == 2 and json.loads(log.read_text())["episodes"] == 3
+
+
+@pytest.mark.slow
+def test_ctrl_c_is_one_line_exit_130_and_the_same_command_resumes(tmp_path):
+    argv = [sys.executable, "-m", "drake_biped", "learn", "--trials", "2", "--episodes", "40", "--distance", "1",
+            "--workers", "2", "--out", str(tmp_path / "l")]
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    trials = tmp_path / "l" / "trials"
+    deadline = time.time() + 120
+    while time.time() < deadline and not (trials.is_dir() and any(trials.iterdir())):
+        time.sleep(0.5)
+    time.sleep(2.0)
+    os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the driver and every worker get it
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 130
+    lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip() and not line.startswith("learning")]
+    assert len(lines) == 1 and "interrupted; run the same command again to resume" in lines[0], lines
+    assert "Traceback" not in err
+    done = sum(len(json.loads(t.read_text())["episodes"]) for t in trials.glob("*.json"))
+    assert json.loads((tmp_path / "l" / "run.json").read_text())["episodes"] == done > 0
+
+
+def _api_cases():
+    import numpy as np
+
+    import drake_biped as db
+    from drake_biped.experiments.gait_search import GaitSearchSettings
+    from drake_biped.experiments.stability import StabilitySettings
+    from drake_biped.experiments.time_step import TimeStepSettings
+    from drake_biped.experiments.window_map import WindowMapSettings
+
+    return [
+        (lambda: db.EpisodeConfig(cpg={"u_a": 1.0}), db.ParameterError, "EpisodeConfig.cpg must be a CpgParams"),
+        (lambda: db.CpgParams(u_a="fast"), db.ParameterError, "CpgParams.u_a must be a number, got 'fast'"),
+        (lambda: db.EpisodeConfig().override({"gait.nope": 1}), db.ParameterError, "'gait.nope' is not"),
+        (lambda: db.TorqueFreeWindow(start_s=-1.0), db.ParameterError, "TorqueFreeWindow.start_s = -1.0"),
+        (lambda: db.EpisodeConfig.from_dict([1]), db.ParameterError, "expected a mapping of EpisodeConfig"),
+        (lambda: db.EpisodeConfig.from_dict({"sim": {"time_step_s": 0.001, "control_period_s": 0.0015}}),
+         db.ParameterError, "whole multiple"),
+        (lambda: db.load_gait("nope"), db.ParameterError, "--params 'nope'"),
+        (lambda: db.Push(force_n=1e6), db.ParameterError, "Push.force_n = 1000000.0"),
+        (lambda: db.SimulationParams(contact_approximation="soft"), db.ParameterError, "'soft' is not one of"),
+        (lambda: db.GarbLearner(variance=0.0), ValueError, "variance must be a finite number > 0"),
+        (lambda: db.fit_return_map([np.zeros((2, 2))]), ValueError, "needs at least 3 pairs"),
+        (lambda: WindowMapSettings(t1_max_s=0.0, t2_max_s=0.05), db.ParameterError, "no window fits"),
+        (lambda: TimeStepSettings(steps=(0.001,), reference_s=0.002), db.ParameterError, "--reference 0.002"),
+        (lambda: StabilitySettings(window=(0.5, 0.2)), db.ParameterError, "need 0 <= t1 < t2"),
+        (lambda: GaitSearchSettings(generations=0), db.ParameterError, "generations (0)"),
+        (lambda: db.EpisodeConfig(push=db.Push(20.0, start_s=70.0)), db.ParameterError, "would never act"),
+    ]
+
+
+@pytest.mark.parametrize("k", range(16))
+def test_bad_values_through_the_api_raise_naming_them(k):
+    make, error, text = _api_cases()[k]
+    with pytest.raises(error) as caught:
+        make()
+    assert text in str(caught.value) and "\n" not in str(caught.value)
