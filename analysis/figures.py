@@ -17,6 +17,7 @@ from drake_biped.analysis.series import moving_average, period  # noqa: E402
 from drake_biped.kinematics import leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
 from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_V, TABLE_V_REDUCTION  # noqa: E402
+from drake_biped.records import atomic_file, save_figure, write_text_atomic  # noqa: E402
 
 JOINTS = ("left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle")
 COLORS = {"left": "#2f6fbf", "right": "#d9661f"}
@@ -70,7 +71,7 @@ def walk_figure(trajectory: dict, path: str | Path, title: str = "") -> None:
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -118,7 +119,8 @@ def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: 
 
     fig.subplots_adjust(bottom=0.17, top=0.97)
     anim = FuncAnimation(fig, draw, frames=n_frames, blit=False)
-    anim.save(path, writer=PillowWriter(fps=fps))
+    with atomic_file(Path(path)) as tmp:
+        anim.save(tmp, writer=PillowWriter(fps=fps))
     plt.close(fig)
 
 
@@ -150,7 +152,7 @@ def window_map_figure(rows: list[dict], baseline_cmt: float | None, path: str | 
     base = f"{baseline_cmt:.3f}" if baseline_cmt else "n/a"
     ax.set_title(f"Torque-free windows: C_mt vs no window (C_mt {base}); x = fell", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -202,7 +204,7 @@ def _learning_figures(record: dict, out: Path) -> list[Path]:
     ax.legend(fontsize=8)
     fig.tight_layout()
     paths.append(out / "fig4_reward.png")
-    fig.savefig(paths[-1], dpi=120)
+    save_figure(fig, paths[-1], dpi=120)
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
@@ -218,7 +220,7 @@ def _learning_figures(record: dict, out: Path) -> list[Path]:
     ax.legend(fontsize=8)
     fig.tight_layout()
     paths.append(out / "fig5_cmt.png")
-    fig.savefig(paths[-1], dpi=120)
+    save_figure(fig, paths[-1], dpi=120)
     plt.close(fig)
 
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11.5, 3.8), sharey=True)
@@ -242,11 +244,11 @@ def _learning_figures(record: dict, out: Path) -> list[Path]:
     ax2.legend(fontsize=6, ncol=2)
     fig.tight_layout()
     paths.append(out / "fig6_times.png")
-    fig.savefig(paths[-1], dpi=120)
+    save_figure(fig, paths[-1], dpi=120)
     plt.close(fig)
 
     paths.append(out / "table_v.md")
-    paths[-1].write_text(table_v(record))
+    write_text_atomic(paths[-1], table_v(record))
     return paths
 
 
@@ -331,7 +333,7 @@ def grid_slices_figure(axes, points: list[dict], rows: list[dict], best: dict, p
         fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.9, label=label)
     fixed = ", ".join(f"{short[a.name]}={best[a.name]:.3g}" for a in axes)
     fig.suptitle(f"Grid search: distance walked, slices through the best point (red star: {fixed})", fontsize=9)
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -362,7 +364,7 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
     ax.set_title(f"Torque-free period during learning ({where})", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(paths[0], dpi=120)
+    save_figure(fig, paths[0], dpi=120)
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
@@ -383,7 +385,7 @@ def slope_figures(record: dict, out: str | Path) -> list[Path]:
     ax.set_title(f"Walking distance during learning ({where})", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(paths[1], dpi=120)
+    save_figure(fig, paths[1], dpi=120)
     plt.close(fig)
     return paths
 
@@ -411,5 +413,5 @@ def landscape_figure(record: dict, path) -> None:
     fig.suptitle("What GARB climbs: expected reward of N(T̄, σ²I) over measured windows (below the dotted "
                  "line: no window)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)

@@ -16,6 +16,7 @@ from typing import Any
 from drake_biped.analysis.series import signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
+from drake_biped.records import save_figure, write_text_atomic
 
 REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
     "reproduced", "partly reproduced", "not reproduced", "differs", "beyond the paper")
@@ -329,7 +330,7 @@ def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: 
                     cell.set_facecolor(colour)
                     break
     ax.set_title(title, fontsize=10)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -354,6 +355,6 @@ def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Any,
                  code: dict[str, Any]) -> list[Path]:
     text = report_markdown(out, summaries, profile, code)
     paths = [out / "report.md", out / "report.html"]
-    paths[0].write_text(text)
-    paths[1].write_text(report_html(text))
+    write_text_atomic(paths[0], text)
+    write_text_atomic(paths[1], report_html(text))
     return paths

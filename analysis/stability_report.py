@@ -11,6 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from drake_biped.records import save_figure, write_text_atomic  # noqa: E402
+
 CONDITIONS = ("without", "with")
 DISTURBANCES = ("undisturbed", "forward", "backward")
 # Fig. 7's colours for 0-4 steps after the push; later steps grey.
@@ -72,7 +74,7 @@ def fig7(record: dict, path: str | Path) -> None:
     fig.legend(handles=handles, loc="lower center", ncol=6, fontsize=8)
     fig.suptitle("Fig. 7: Poincaré return map of the inter-leg hip angle θ at touchdown", fontsize=10)
     fig.tight_layout(rect=(0, 0.05, 1, 0.97))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -204,6 +206,6 @@ def write_stability_outputs(record: dict, out: str | Path) -> list[Path]:
     out = Path(out)
     paths = [out / "fig7_return_map.png", out / "report.md", out / "report.html"]
     fig7(record, paths[0])
-    paths[1].write_text(report_markdown(record))
-    paths[2].write_text(report_html(record))
+    write_text_atomic(paths[1], report_markdown(record))
+    write_text_atomic(paths[2], report_html(record))
     return paths

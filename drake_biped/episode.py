@@ -22,6 +22,7 @@ from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
 from drake_biped.model import JOINT_NAMES, joint_index
 from drake_biped.params import GRAVITY_MPS2, EpisodeConfig
+from drake_biped.records import atomic_file, write_text_atomic
 from drake_biped.versions import versions
 
 
@@ -93,7 +94,7 @@ class EpisodeResult:
         return d
 
     def to_json(self, path: str | Path) -> None:
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n")
+        write_text_atomic(Path(path), json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n")
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> EpisodeResult:
@@ -104,7 +105,8 @@ class EpisodeResult:
     def save_trajectory(self, path: str | Path) -> None:
         if self.trajectory is None:
             raise ValueError("this result holds no trajectory; run the episode with record_trajectory=True")
-        np.savez_compressed(path, **self.trajectory)
+        with atomic_file(Path(path).with_suffix(".npz")) as tmp:
+            np.savez_compressed(tmp, **self.trajectory)
 
 
 def _finite_or_none(x: float) -> float | None:

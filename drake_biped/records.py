@@ -5,12 +5,15 @@ from __future__ import annotations
 import json
 import os
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from drake_biped.params import ParameterError
 
-__all__ = ["read_json", "read_kept", "set_aside", "warn", "write_atomic", "write_text_atomic"]
+__all__ = ["atomic_file", "read_json", "read_kept", "save_figure", "set_aside", "warn", "write_atomic",
+           "write_text_atomic"]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -70,3 +73,23 @@ def read_kept(path: Path) -> Any | None:
     except (json.JSONDecodeError, UnicodeDecodeError):
         set_aside(path, "is not valid JSON (a damaged result); it is computed again")
         return None
+
+
+@contextmanager
+def atomic_file(path: Path) -> Iterator[Path]:
+    """A temporary path beside `path` (same suffix, so writers that go by it pick the format) to write to;
+    renamed to `path` when the block ends without error, removed otherwise: `path` is whole or as it was."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def save_figure(fig, path: Path, **kwargs) -> None:
+    """`fig.savefig(path, **kwargs)`, atomically."""
+    with atomic_file(path) as tmp:
+        fig.savefig(tmp, **kwargs)

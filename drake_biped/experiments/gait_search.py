@@ -176,7 +176,7 @@ def _read_log(path: Path) -> list[dict]:
             if i != len(lines) - 1:
                 raise ParameterError(f"{path}, line {i + 1}: not valid JSON ({exc}); only a last line cut short "
                                      "by a kill is dropped: repair or delete that line to resume") from None
-            path.write_text("".join(json.dumps(r) + "\n" for r in records))
+            write_text_atomic(path, "".join(json.dumps(r) + "\n" for r in records))
     return records
 
 

@@ -35,7 +35,7 @@ from drake_biped.experiments.learning import make_settings, run_learning, trial_
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
 from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow
-from drake_biped.records import write_atomic
+from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
 MOVING_AVERAGE = SLOPE_MOVING_AVERAGE  # episodes, as in the paper's Figs. 8-11
@@ -152,7 +152,7 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
         "versions": code,
     }
     write_atomic(out / "slope.json", record)
-    (out / "report.md").write_text(report_markdown(record))
+    write_text_atomic(out / "report.md", report_markdown(record))
     slope_figures(record, out)
     return record
 

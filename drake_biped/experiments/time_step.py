@@ -17,7 +17,7 @@ from pathlib import Path
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams, TorqueFreeWindow
-from drake_biped.records import read_json, write_text_atomic
+from drake_biped.records import read_json, save_figure, write_text_atomic
 from drake_biped.versions import versions
 
 WALKS = [None, (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7)]
@@ -162,7 +162,7 @@ def figure(rec: dict, path: Path) -> None:
     ax.set_title("Time-step study (×: a fall; grey: ±2 %)")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
 
 

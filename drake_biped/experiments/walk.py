@@ -14,6 +14,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
 from drake_biped.params import EpisodeConfig
+from drake_biped.records import write_text_atomic
 
 
 class GraphvizMissingError(RuntimeError):
@@ -26,7 +27,7 @@ def export_diagram(diagram: Diagram, out_dir: Path, stem: str = "diagram", max_d
     Raises GraphvizMissingError (after writing the .dot file) when `dot` is not on PATH."""
     out_dir = Path(out_dir)
     dot_path = out_dir / f"{stem}.dot"
-    dot_path.write_text(diagram.GetGraphvizString(max_depth=max_depth))
+    write_text_atomic(dot_path, diagram.GetGraphvizString(max_depth=max_depth))
     dot = shutil.which("dot")
     if dot is None:
         raise GraphvizMissingError(
@@ -82,7 +83,7 @@ def write_meshcat_html(meshcat, path: Path, follow: tuple[np.ndarray, np.ndarray
                               np.array([0.0, 0.0, CAMERA_TARGET_Z_M]))
     meshcat.StopRecording()
     meshcat.PublishRecording()
-    Path(path).write_text(meshcat.StaticHtml())
+    write_text_atomic(Path(path), meshcat.StaticHtml())
 
 
 @dataclass(frozen=True)
