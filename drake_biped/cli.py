@@ -233,7 +233,7 @@ def cmd_figures(args: argparse.Namespace) -> int:
     from drake_biped.records import read_json
 
     out = Path(args.dir)
-    for p in learning_figures(read_json(out / "learning.json", "figures: learning record"), out):
+    for p in learning_figures(read_json(out / "learning.json", "figures DIR"), out):
         print(f"wrote {p}")
     return 0
 

@@ -121,7 +121,12 @@ class _Validated:
                 kwargs[name] = None if value is None else sub.from_dict(value, inner)
             else:
                 kwargs[name] = value
-        return cls(**kwargs)
+        try:
+            return cls(**kwargs)
+        except ParameterError as exc:
+            if where == cls.__name__:
+                raise
+            raise ParameterError(f"{where}: {exc}") from None
 
 
 @dataclass(frozen=True)

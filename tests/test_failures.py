@@ -54,7 +54,7 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
     (["walk", "--params", "{file:section.json}", "--out", "{tmp}/w"], ["section 'cpg'", "got str 'fast'"]),
     (["walk", "--params", "{file:bad.json}", "--out", "{tmp}/w"], ["bad.json", "not valid JSON"]),
     (["walk", "--params", "{file:unknown.json}", "--out", "{tmp}/w"], ["unknown parameter", "u_q"]),
-    (["walk", "--params", "{file:range.json}", "--out", "{tmp}/w"], ["CpgParams.alpha = 9.0", "[-2, 2]"]),
+    (["walk", "--params", "{file:range.json}", "--out", "{tmp}/w"], ["range.json, section 'cpg'", "CpgParams.alpha = 9.0", "[-2, 2]"]),
     (["walk", "--params", "climbin", "--out", "{tmp}/w"], ["--params 'climbin'", "climbing"]),
     (["walk", "--t1", "0.5", "--out", "{tmp}/w"], ["--t1 and --t2"]),
     (["walk", "--t1", "0.5", "--t2", "0.2", "--out", "{tmp}/w"], ["--t1 0.5 --t2 0.2", "no torque-free window"]),

@@ -98,7 +98,7 @@ def test_figures_are_redrawn_from_the_records_alone(tmp_path):
 def test_figures_without_a_record_is_a_clear_error(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["figures", str(tmp_path)])
-    assert "figures: learning record: no such file" in capsys.readouterr().err
+    assert "figures DIR: no such file" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("argv, match", [

@@ -39,11 +39,11 @@ def run(settings: LandscapeSettings, out: Path | None = None, client=None, progr
 
     path = settings.path()
     if not path.is_file():
-        raise ParameterError(f"landscape: no window map at {settings.window_map} (run drake-biped window-map first)")
+        raise ParameterError(f"no window map at {settings.window_map} (run drake-biped window-map first)")
     try:
         rewards = WindowRewards.from_window_map(json.loads(path.read_text()))
     except (json.JSONDecodeError, KeyError, TypeError) as exc:
-        raise ParameterError(f"landscape: {path} is not a window map ({exc})") from None
+        raise ParameterError(f"{path} is not a window map ({exc})") from None
     record = landscape(rewards, list(settings.variances), samples=settings.samples, seed=settings.seed,
                        starts=[tuple(s) for s in settings.starts])
     record.update(window_map=str(path), samples=settings.samples, seed=settings.seed, versions=versions())
