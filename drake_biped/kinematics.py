@@ -23,7 +23,6 @@ TORSO_M = TABLE_I_LENGTHS_M["torso"]
 # Contact spheres: centre one radius above the sole, at the heel and at the toe.
 _SPHERE_Z = -SOLE_DEPTH_M + CONTACT_RADIUS_M
 FOOT_COM_M = (0.03, -0.015)  # foot centre of mass in the ankle frame (x, z; m)
-_FOOT_COM = FOOT_COM_M
 
 
 class LinkMasses(NamedTuple):
@@ -96,6 +95,6 @@ def center_of_mass_from_legs(x: float, z: float, pitch: float, left: LegPoints, 
         sx += mth * 0.5 * (x + p.knee_x) + msh * 0.5 * (p.knee_x + p.ankle_x)
         sz += mth * 0.5 * (z + p.knee_z) + msh * 0.5 * (p.knee_z + p.ankle_z)
         c, s = math.cos(p.foot_angle), math.sin(p.foot_angle)
-        sx += mft * (p.ankle_x + _FOOT_COM[0] * c - _FOOT_COM[1] * s)
-        sz += mft * (p.ankle_z + _FOOT_COM[0] * s + _FOOT_COM[1] * c)
+        sx += mft * (p.ankle_x + FOOT_COM_M[0] * c - FOOT_COM_M[1] * s)
+        sz += mft * (p.ankle_z + FOOT_COM_M[0] * s + FOOT_COM_M[1] * c)
     return sx / total, sz / total
