@@ -410,8 +410,11 @@ class _HelpFormatter(argparse.HelpFormatter):
 class _Parser(argparse.ArgumentParser):
     """Option errors as one line naming the option and the value (exit code 2), without the usage block."""
 
+    def exit(self, status: int = 0, message: str | None = None):
+        _remove_empty_made_folders()  # --help or an option error: the command never ran
+        super().exit(status, message)
+
     def error(self, message: str):
-        _remove_empty_made_folders()
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
