@@ -25,7 +25,7 @@ from pydrake.multibody.plant import (
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_biped.kinematics import FOOT_COM_M, SHANK_M, THIGH_M, TORSO_M, LinkMasses, link_masses
-from drake_biped.params import CONTACT_RADIUS_M, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M, Ground
+from drake_biped.params import CONTACT_RADIUS_M, GRAVITY_MPS2, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M, Ground
 from drake_biped.resources import model_package_xml
 
 MODEL_URL = "package://drake_biped/biped.urdf"
@@ -202,6 +202,8 @@ def check_geometry(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: 
     def xz(v) -> list[float]:
         return [float(v[0]), float(v[2])]
 
+    check("gravity (x, y, z, m/s^2; C_mt divides by m g d with g = params.GRAVITY_MPS2)",
+          plant.gravity_field().gravity_vector(), [0.0, 0.0, -GRAVITY_MPS2])
     check("torso centre of mass (x, z in the torso frame, m)", xz(plant.GetBodyByName("torso").default_com()),
           [0.0, 0.5 * TORSO_M])
     for leg in LEGS:

@@ -226,3 +226,14 @@ def test_bad_values_through_the_api_raise_naming_them(k):
     with pytest.raises(error) as caught:
         make()
     assert text in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_a_damaged_grid_point_line_is_named_and_recomputed(tmp_path, capsys):
+    from drake_biped.experiments.grid import read_points
+
+    store = tmp_path / "points.jsonl"
+    store.write_text('{"key": "a", "distance_m": 1.0}\n{"key": "b", "dist\n{"key": "c", "distance_m": 2.0}\n{"ke')
+    assert sorted(read_points(store)) == ["a", "c"]
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "points.jsonl, line 2: not a grid point record" in err
+    assert store.read_text().count("\n") == 3  # the file is left as it is

@@ -32,7 +32,7 @@ from typing import Any
 
 from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
 from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError
-from drake_biped.records import write_atomic, write_text_atomic
+from drake_biped.records import warn, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
 __all__ = ["Axis", "GridSettings", "load_spec", "parse_spec", "run", "run_grid", "summary_lines", "table_iv_axes"]
@@ -177,15 +177,19 @@ def better(a: dict[str, Any], b: dict[str, Any] | None) -> bool:
 
 
 def read_points(path: Path) -> dict[str, dict[str, Any]]:
-    """Finished rows of OUT/points.jsonl by key; unreadable lines (a killed write) are skipped."""
+    """Finished rows of OUT/points.jsonl by key. An unreadable line is skipped and its point computed again:
+    the last line silently (a write cut short by a kill), any other with a warning naming the line (the file
+    is kept as it is; the recomputed row is appended)."""
     rows: dict[str, dict[str, Any]] = {}
     if path.is_file():
-        for line in path.read_text().splitlines():
+        lines = path.read_text().splitlines()
+        for k, line in enumerate(lines):
             try:
                 row = json.loads(line)
                 rows[row["key"]] = row
             except (json.JSONDecodeError, KeyError, TypeError):
-                continue
+                if k != len(lines) - 1 and line.strip():
+                    warn(f"{path}, line {k + 1}: not a grid point record; its point is computed again")
     return rows
 
 
