@@ -16,14 +16,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from drake_biped.model import ModelError
-from drake_biped.params import (
-    EpisodeConfig,
-    Ground,
-    ParameterError,
-    Push,
-    SimulationParams,
-    TorqueFreeWindow,
-)
+from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow
 
 
 def _number(kind: str):
@@ -106,28 +99,20 @@ def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     from drake_biped.resources import load_gait
 
     config = EpisodeConfig() if args.params is None else load_gait(args.params)
-    sim = config.sim
-    if args.distance is not None or args.max_time is not None or args.time_step is not None:
-        sim_d = sim.to_dict()
-        if args.distance is not None:
-            sim_d["distance_m"] = args.distance
-            if args.max_time is None:
-                sim_d["max_time_s"] = max(sim.max_time_s, 6.0 * args.distance)
-        if args.max_time is not None:
-            sim_d["max_time_s"] = args.max_time
-        if args.time_step is not None:
-            sim_d["time_step_s"] = args.time_step
-            sim_d["control_period_s"] = args.time_step
-        sim = SimulationParams(**sim_d)
-    ground = config.ground
-    if args.slope is not None or args.level_length is not None:
-        ground = Ground(
-            slope_rad=args.slope if args.slope is not None else ground.slope_rad,
-            level_length_m=args.level_length if args.level_length is not None else ground.level_length_m,
-            friction=ground.friction,
-        )
-    seed = args.seed if args.seed is not None else config.seed
-    return config.replace(sim=sim, ground=ground, seed=seed)
+    changes: dict[str, float] = {}
+    if args.distance is not None:
+        changes["sim.distance_m"] = args.distance
+        changes["sim.max_time_s"] = max(config.sim.max_time_s, 6.0 * args.distance)
+    if args.max_time is not None:
+        changes["sim.max_time_s"] = args.max_time
+    if args.time_step is not None:
+        changes["sim.time_step_s"] = changes["sim.control_period_s"] = args.time_step
+    if args.slope is not None:
+        changes["ground.slope_rad"] = args.slope
+    if args.level_length is not None:
+        changes["ground.level_length_m"] = args.level_length
+    config = config.override(changes)
+    return config if args.seed is None else config.replace(seed=args.seed)
 
 
 @contextmanager
@@ -135,8 +120,7 @@ def _client(args: argparse.Namespace):
     """The Dask client of the cluster options: --scheduler ADDR, or a LocalCluster of --workers N."""
     from drake_biped.experiments.executor import dask_client
 
-    _check_cluster_options(args)
-    with dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+    with dask_client(workers=args.workers, scheduler=args.scheduler) as client:  # it checks the options first
         yield client
 
 
@@ -199,8 +183,6 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     if args.replot:
-        if not (out / "time_step_study.json").is_file():
-            raise ParameterError(f"--replot: no time_step_study.json in {out}")
         rec = time_step.replot(out)
     else:
         settings = time_step.TimeStepSettings(tuple(args.steps), args.reference, args.distance)
@@ -275,15 +257,6 @@ def _chosen_window(args: argparse.Namespace) -> tuple[float, float]:
     return 0.2, 0.5
 
 
-def _check_cluster_options(args: argparse.Namespace) -> None:
-    from drake_biped.experiments.executor import check_scheduler_address
-
-    if args.scheduler is not None:
-        check_scheduler_address(args.scheduler)
-        if args.workers is not None:
-            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
-
-
 def cmd_stability(args: argparse.Namespace) -> int:
     from drake_biped.experiments import stability
 
@@ -354,10 +327,11 @@ def cmd_slope(args: argparse.Namespace) -> int:
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
     from drake_biped.experiments import reproduce
+    from drake_biped.experiments.executor import check_cluster_options
 
     profile = reproduce.QUICK if args.quick else reproduce.FULL
     out = Path(args.out)
-    _check_cluster_options(args)
+    check_cluster_options(args.workers, args.scheduler)  # before the folder is claimed for this profile
     reproduce.check_out(out, profile)
     hours = profile.expected_minutes / 60
     print(f"reproduce ({profile.name}): {len(reproduce.Reproduction.STEPS)} experiments into {out}/, expected "

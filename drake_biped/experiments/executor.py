@@ -33,6 +33,16 @@ def check_scheduler_address(address: str) -> str:
     return address
 
 
+def check_cluster_options(workers: int | None, scheduler: str | None) -> None:
+    """ParameterError unless the options name one cluster: --scheduler ADDR, or a local one of --workers N."""
+    if scheduler is not None:
+        if workers is not None:
+            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
+        check_scheduler_address(scheduler)
+    elif workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
+
+
 @contextmanager
 def client_or_local(client: Any = None) -> Iterator[Any]:
     """`client` itself when given, else a LocalCluster's client for the duration of the block."""
@@ -53,11 +63,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     from distributed import Client
 
     logging.getLogger("distributed").setLevel(logging.WARNING)
+    check_cluster_options(workers, scheduler)
     if scheduler is not None:
-        if workers is not None:
-            raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
         try:
-            client = Client(check_scheduler_address(scheduler), timeout=SCHEDULER_TIMEOUT)
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
         except (OSError, TimeoutError) as exc:
             raise ParameterError(f"--scheduler {scheduler}: no Dask scheduler answered within "
                                  f"{SCHEDULER_TIMEOUT} ({type(exc).__name__}); start one (dask scheduler) or "
@@ -67,8 +76,6 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
         finally:
             client.close()
         return
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
     n = workers or max(1, os.cpu_count() or 1)
     with _workers_ignore_ctrl_c():
         cluster = _local_cluster(n)

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -14,7 +13,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
 from drake_biped.params import EpisodeConfig
-from drake_biped.records import write_text_atomic
+from drake_biped.records import warn, write_text_atomic
 
 
 class GraphvizMissingError(RuntimeError):
@@ -173,7 +172,3 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
                            ground_height=config.ground.height)
         walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
     return result
-
-
-def warn(message: str) -> None:
-    print(f"drake-biped: warning: {message}", file=sys.stderr)
