@@ -171,7 +171,8 @@ def cmd_gait_search(args: argparse.Namespace) -> int:
     config = _episode_config(args)
     settings = gait_search.GaitSearchSettings(
         config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
-        distance_m=config.sim.distance_m if args.distance is not None else 6.0)
+        distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
+        objective=args.objective)
     with _client(args) as client:
         result = gait_search.run(settings, Path(args.out), client)
     print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
@@ -438,6 +439,12 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
     search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
     search.add_argument("--sigma", type=_number("positive"), default=0.1, help="mutation scale (default 0.1)")
+    search.add_argument("--mutations", choices=["default", "paper"], default="default",
+                        help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains) or 'paper' (only what "
+                             "the paper does not print: the CPG and the initiation held)")
+    search.add_argument("--objective", choices=["windows", "walk", "policy"], default="windows",
+                        help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
+                             "find a walker), 'policy' (the expected reward of the paper's start policy)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

@@ -17,9 +17,15 @@ Both layouts are declared once below; outside the update, read them by name (`CO
 Timing: the plant's output ports are sampled (Drake's default for a discrete plant), so the state the
 update at context time t reads is the plant state at t + h, h the plant time step, and the torques it
 computes act from t + h on: state feedback without delay. The touchdown times and STATE_TIME are the
-times of the states read, which are also the time stamps the state log gives those states; the CPG phase
-and the torque-free window count from STEP_START, the context time of the touchdown update.
-tests/test_hot_path.py pins this down.
+times of the states read, which are also the time stamps the state log gives those states.
+
+Events at sub-step accuracy, so that the step map, C_mt and the reward are continuous in the state and in
+the window's bounds (benchmarks/kick_sweep.py measures it): a touchdown is placed at the instant T_n the
+swing foot's clearance crossed the touchdown height, interpolated between two updates; the step clock, the
+CPG phase and the torque-free window all count from T_n; the section angle is interpolated to T_n and the
+section rate extrapolated to T_n from the two updates before it (before the impact, which a 1 ms update
+would otherwise sample at a random depth); and a control period that a window edge cuts applies the
+servo's torque scaled by the part of the period outside the window. tests/test_hot_path.py pins this down.
 """
 
 from __future__ import annotations
@@ -39,11 +45,12 @@ from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
 CONTROLLER_STATE = VectorLayout("controller_state", (
     Field("cpg_phase", 1, "CPG phase gamma (rad)"),
     Field("stance_right", 1, "1.0 when the right leg is the stance leg"),
-    Field("step_start_s", 1, "T_n, context time of the last touchdown update (s)"),
+    Field("step_start_s", 1, "T_n, the last touchdown: when the swing foot's clearance crossed the touchdown "
+                             "height, interpolated within the control period (plant-state time, s)"),
     Field("liftoff_angle_rad", 1, "swing thigh world angle at T_n (rad)"),
     Field("step_count", 1, "touchdowns so far"),
     Field("hip_integral", 1, "swing-hip PID integrator (rad*s)"),
-    Field("torque_free", 1, "1.0 while the swing hip is torque-free"),
+    Field("torque_free", 1, "the part of the control period the swing hip is torque-free (1.0: all of it)"),
     Field("fall_code", 1, "why the episode fell, a key of FALL_REASONS (0: it did not)"),
     Field("com_x_m", 1, "whole-body centre of mass x at the last update (m)"),
     Field("target_x_m", 1, "the episode ends when com_x_m reaches this (m)"),
@@ -54,6 +61,11 @@ CONTROLLER_STATE = VectorLayout("controller_state", (
     Field("positive_work_j", 6, "per-joint integrals of max(tau * omega, 0) dt (J)"),
     Field("signed_work_j", 6, "per-joint integrals of tau * omega dt (J)"),
     Field("previous_clearance_m", 1, "the swing foot's clearance at the previous update (m)"),
+    Field("previous_pitch_rad", 1, "torso pitch at the previous update (rad)"),
+    Field("previous_section_rates_radps", 2, "swing minus stance hip rate at the previous two updates, latest "
+                                             "first; NaN until read in this step (rad/s)"),
+    Field("swing_travel_rad", 1, "integral of zeta since T_n: the swing thigh's travel under the integrated "
+                                 "reading (rad)"),
 ))
 N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
@@ -63,6 +75,7 @@ STEP_COUNT, INTEGRAL, GATE, FALL = _o("step_count"), _o("hip_integral"), _o("tor
 COM_X, TARGET_X, DONE, STATE_TIME = _o("com_x_m"), _o("target_x_m"), _o("done"), _o("state_time_s")
 Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
 POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_work_j"), _o("previous_clearance_m")
+PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_rates_radps"), _o("swing_travel_rad")
 del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
@@ -126,6 +139,7 @@ class CpgWalkingController(LeafSystem):
         initial[LIFTOFF_ANGLE] = initial_liftoff_angle
         initial[TARGET_X] = math.inf
         initial[PREV_CLEARANCE] = math.inf
+        initial[PREV_RATES : PREV_RATES + 2] = math.nan
         self._torque_group = self.DeclareDiscreteState(6)
         self._state_group = self.DeclareDiscreteState(BasicVector(initial))
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
@@ -151,6 +165,7 @@ class CpgWalkingController(LeafSystem):
         self._gait = config.gait
         self._window = config.window
         self._amplitude = config.cpg.swing_amplitude_rad
+        self._integrated = config.gait.swing_reading == "integrated"
         self._fall_height = config.sim.fall_hip_height_m
         self._fall_pitch = config.sim.fall_pitch_rad
 
@@ -178,12 +193,14 @@ class CpgWalkingController(LeafSystem):
         distance_m: float = math.inf,
         stance_right: bool | None = None,
         liftoff_angle: float | None = None,
+        pitch: float = 0.0,
     ) -> None:
-        """Seed the work integrator's previous angles, the centre-of-mass x and the distance to walk, and
-        (when given) the first stance leg and the swing thigh's lift-off angle."""
+        """Seed the work integrator's previous angles (and the torso pitch), the centre-of-mass x and the
+        distance to walk, and (when given) the first stance leg and the swing thigh's lift-off angle."""
         s = context.get_mutable_discrete_state(self._state_group)
         s.SetAtIndex(COM_X, com_x)
         s.SetAtIndex(TARGET_X, com_x + distance_m)
+        s.SetAtIndex(PREV_PITCH, pitch)
         for i in range(6):
             s.SetAtIndex(Q_PREV + i, float(joint_angles[i]))
         if stance_right is not None:
@@ -206,13 +223,17 @@ class CpgWalkingController(LeafSystem):
         x = self._plant_state.Eval(context).tolist()
         s = context.get_discrete_state(self._state_group).value().tolist()
         g = self._gait
-        s[STATE_TIME] = t + self._state_lag
+        dt = self._dt
+        now = t + self._state_lag  # the time of the plant state read (see "Timing")
+        s[STATE_TIME] = now
         q, v = x[:9], x[9:]
+        q_prev = s[Q_PREV : Q_PREV + 6]
+        pitch_prev = s[PREV_PITCH]
 
         # Work done by the held torques since the last update: tau is constant over the interval,
         # so its work on each joint is exactly tau * (q_now - q_prev).
         for i in range(6):
-            w = s[TAU + i] * (q[3 + i] - s[Q_PREV + i])
+            w = s[TAU + i] * (q[3 + i] - q_prev[i])
             s[SIGNED_WORK + i] += w
             if w > 0.0:
                 s[POSITIVE_WORK + i] += w
@@ -227,6 +248,7 @@ class CpgWalkingController(LeafSystem):
 
         px, pz, pitch = q[0], q[1], q[2]
         pitch_rate = v[2]
+        s[PREV_PITCH] = pitch
         left = leg_points(px, pz, pitch, q[3], q[4], q[5])
         right = leg_points(px, pz, pitch, q[6], q[7], q[8])
         stance_right = s[STANCE_RIGHT] > 0.5
@@ -236,62 +258,82 @@ class CpgWalkingController(LeafSystem):
         s[COM_X] = com_x
 
         # Touchdown: swap the roles, reset the CPG phase (phase resetting), record the section state.
-        time_in_step = t - s[STEP_START]
         ground = self._ground
         clearance = min(swing.heel_z - ground.height(swing.heel_x), swing.toe_z - ground.height(swing.toe_x))
         advance = swing.ankle_x - stance.ankle_x
         c_prev = s[PREV_CLEARANCE]
         s[PREV_CLEARANCE] = clearance
-        if gait.is_touchdown(g, time_in_step, clearance, advance, s[GAMMA]):
+        rate_1, rate_2 = s[PREV_RATES], s[PREV_RATES + 1]
+        s[PREV_RATES + 1] = rate_1
+        s[PREV_RATES] = v[sw_i] - v[st_i]  # the section rate, were the swing foot to land now
+        if gait.is_touchdown(g, now - s[STEP_START], clearance, advance, s[GAMMA]):
             stance_right = not stance_right
             st_i, sw_i = sw_i, st_i
             stance, swing = swing, stance
+            # T_n: the moment the clearance crossed the touchdown height, linearly between this update and
+            # the previous one, when the crossing is what confirmed the touchdown (otherwise this update).
+            back = 0.0
+            thr = g.touchdown_height_m
+            crossed = math.isfinite(c_prev) and c_prev > thr >= clearance
+            if crossed:
+                back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * dt
+            f = back / dt  # how far back towards the previous update T_n lies
+            angle = (1.0 - f) * (q[st_i] - q[sw_i]) + f * (q_prev[st_i - 3] - q_prev[sw_i - 3])
+            if crossed and math.isfinite(rate_2):
+                # both rates were read before the foot reached the ground: extrapolate them to T_n
+                rate = rate_1 + (rate_1 - rate_2) * (1.0 - f)
+            else:
+                rate = v[st_i] - v[sw_i]
+            step_start = now - back
             n = int(s[STEP_COUNT])
             if n < self._capacity:
-                # The section state at the moment the clearance crossed the touchdown height, linearly
-                # between this update and the previous one (when the crossing is what confirmed the
-                # touchdown): without it, section states would be quantised by the control period
-                # (rate x period, ~3 mrad), which finite-difference studies of the step map cannot bear.
-                back = 0.0
-                thr = g.touchdown_height_m
-                if math.isfinite(c_prev) and c_prev > thr >= clearance:
-                    back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * self._dt
-                rate = v[st_i] - v[sw_i]
-                row = (t + self._state_lag - back, q[st_i] - q[sw_i] - back * rate, rate,
-                       1.0 if stance_right else 0.0, com_x)
+                row = (step_start, angle, rate, 1.0 if stance_right else 0.0, com_x)
                 td = discrete_state.get_mutable_vector(self._touchdown_group)
                 for k in range(_TD):
                     td.SetAtIndex(n * _TD + k, row[k])
             s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
-            s[STEP_START] = t
-            s[LIFTOFF_ANGLE] = swing.thigh_angle
+            s[STEP_START] = step_start
+            # the new swing thigh's world angle at T_n
+            s[LIFTOFF_ANGLE] = (1.0 - f) * swing.thigh_angle + f * (pitch_prev + q_prev[sw_i - 3])
             s[STEP_COUNT] = n + 1.0
             s[PREV_CLEARANCE] = math.inf  # the next swing foot's clearance is not yet known
-            s[GAMMA] = 0.0
+            s[PREV_RATES : PREV_RATES + 2] = [math.nan, math.nan]
+            s[GAMMA] = cpg.advance_phase(self._cpg, 0.0, v[st_i + ANKLE], back)  # the phase since T_n
             s[INTEGRAL] = 0.0
-            time_in_step = 0.0
+            s[TRAVEL] = back * cpg.output(self._cpg, 0.5 * s[GAMMA])
+
+        # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
+        elapsed = now - s[STEP_START]
 
         # CPG (eq. 2-3) and the swing reference.
-        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + ANKLE], self._dt)
-        s[GAMMA] = gamma
+        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + ANKLE], dt)
         zeta = cpg.output(self._cpg, gamma)
-        target = gait.placement_target(g, self._amplitude, px - stance.ankle_x, v[0])
-        reference = cpg.swing_reference(gamma, s[LIFTOFF_ANGLE], target)
+        s[GAMMA] = gamma
+        s[TRAVEL] += dt * zeta
+        if self._integrated:
+            # Table III's zeta drives the swing as printed: the reference angle is its integral from the
+            # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
+            offset = g.swing_offset_rad + gait.placement_feedback(g, px - stance.ankle_x, v[0])
+            reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
+        else:
+            target = gait.placement_target(g, self._amplitude, px - stance.ankle_x, v[0])
+            reference = cpg.swing_reference(gamma, s[LIFTOFF_ANGLE], target)
         swing_rate = pitch_rate + v[sw_i]
         angle_error = reference - swing.thigh_angle
 
-        # Torque-free gate: exactly zero swing-hip torque, integrator frozen.
-        gated = s[STEP_COUNT] >= self._window.first_step and cpg.in_torque_free_window(
-            time_in_step, self._window.start_s, self._window.end_s
-        )
-        if gated:
+        # Torque-free gate: the servo's torque scaled by the part of the period outside the window (exactly
+        # zero for a period inside it), the integrator advanced by that part only.
+        free = 0.0
+        if s[STEP_COUNT] >= self._window.first_step:
+            free = cpg.torque_free_fraction(elapsed, dt, self._window.start_s, self._window.end_s)
+        if free >= 1.0:
             tau_swing_hip = 0.0
         else:
-            s[INTEGRAL] += angle_error * self._dt
-            tau_swing_hip = gait.clip(
+            s[INTEGRAL] += angle_error * dt * (1.0 - free)
+            tau_swing_hip = (1.0 - free) * gait.clip(
                 gait.hip_servo_torque(g, angle_error, zeta - swing_rate, s[INTEGRAL]), _HIP_LIMIT
             )
-        s[GATE] = 1.0 if gated else 0.0
+        s[GATE] = free
         tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
 
         a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)

@@ -56,3 +56,17 @@ def in_torque_free_window(time_in_step_s: float, start_s: float, end_s: float) -
     """True while the hip motor is off: start_s <= time since T_n < end_s (to WINDOW_TOLERANCE_S),
     and end_s > start_s."""
     return end_s > start_s and start_s - WINDOW_TOLERANCE_S <= time_in_step_s < end_s - WINDOW_TOLERANCE_S
+
+
+def torque_free_fraction(elapsed_s: float, period_s: float, start_s: float, end_s: float) -> float:
+    """The part of the control period [elapsed_s, elapsed_s + period_s) (times since T_n) that lies in the
+    window [start_s, end_s): 0 outside, 1 inside, and in between where an edge cuts the period, so that the
+    gate's edges act at their exact times. Overlaps within WINDOW_TOLERANCE_S of 0 or 1 count as 0 or 1."""
+    if not end_s > start_s:
+        return 0.0
+    overlap = min(elapsed_s + period_s, end_s) - max(elapsed_s, start_s)
+    if overlap <= WINDOW_TOLERANCE_S:
+        return 0.0
+    if overlap >= period_s - WINDOW_TOLERANCE_S:
+        return 1.0
+    return overlap / period_s

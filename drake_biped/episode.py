@@ -210,7 +210,8 @@ def simulate(
     parts.plant.SetVelocities(plant_ctx, v0)
     com_x0 = center_of_mass(q0, parts.masses)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
-    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff)
+    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
+                                      pitch=q0[2])
     group = parts.controller.state_group
     if progress is not None:
         next_report = [0.0]

@@ -27,9 +27,14 @@ def torso_torque(gait: GaitParams, pitch: float, pitch_rate: float) -> float:
     return gait.torso_kp * (pitch - gait.torso_pitch_rad) + gait.torso_kd * pitch_rate
 
 
+def placement_feedback(gait: GaitParams, hip_ahead_of_stance_m: float, hip_speed: float) -> float:
+    """Raibert-style foot-placement feedback (rad): reach further the further ahead and faster the hip is."""
+    return gait.placement_gain * hip_ahead_of_stance_m + gait.placement_velocity_gain * hip_speed
+
+
 def placement_target(gait: GaitParams, amplitude: float, hip_ahead_of_stance_m: float, hip_speed: float) -> float:
-    """End-of-swing thigh angle: the CPG amplitude plus Raibert-style foot-placement feedback."""
-    return amplitude + gait.placement_gain * hip_ahead_of_stance_m + gait.placement_velocity_gain * hip_speed
+    """End-of-swing thigh angle of the anchored reading: the CPG amplitude plus foot-placement feedback."""
+    return amplitude + placement_feedback(gait, hip_ahead_of_stance_m, hip_speed)
 
 
 def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float, thigh_angle: float) -> float:

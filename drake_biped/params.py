@@ -165,8 +165,22 @@ PAPER_CPG = CpgParams(**TABLE_III)  # Table III as printed.
 
 @dataclass(frozen=True)
 class GaitParams(_Validated):
-    """Gains and thresholds of the hip servo, torso balance, knees, ankles and touchdown detection."""
+    """Gains and thresholds of the hip servo, torso balance, knees, ankles and touchdown detection.
 
+    `swing_reading` says how eq. 2-3's zeta (the desired swing-thigh angular velocity) drives the swing:
+    - "anchored": the reference angle runs from the lift-off angle phi_0 to a target,
+      phi_0 + (phi_T - phi_0) (1 - cos gamma) / 2, with phi_T = alpha u_a / u_r plus foot-placement feedback;
+      its rate equals zeta only when phi_T - phi_0 = 2 alpha u_a / u_r, so feedback rescales the CPG (and the
+      target counts u_r, not the phase's real rate u_r + kappa * ankle rate).
+    - "integrated": the reference angle is phi_0 + the integral of zeta since T_n, as printed; placement
+      feedback (and swing_offset_rad) only add an offset blended in by (1 - cos gamma) / 2. Both readings
+      servo the rate to zeta itself.
+    """
+
+    # How zeta drives the swing (above): "anchored" or "integrated".
+    swing_reading: str = "anchored"
+    # Integrated reading: a constant offset of the swing reference at the end of the half-cycle (rad).
+    swing_offset_rad: float = 0.0
     # Swing hip: PID servo of the swing thigh's world angle to the CPG reference (angle, zeta).
     hip_kp: float = 90.0  # N*m/rad
     hip_kd: float = 11.0  # N*m*s/rad
@@ -225,7 +239,16 @@ class GaitParams(_Validated):
         "touchdown_height_m": (0.0, 0.05),
         "touchdown_min_advance_m": (-0.5, 0.5),
         "touchdown_min_phase": (0.0, math.pi),
+        "swing_offset_rad": (-1.5, 1.5),
     }
+
+    SWING_READINGS = ("anchored", "integrated")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.swing_reading not in self.SWING_READINGS:
+            raise ParameterError(f"GaitParams.swing_reading = {self.swing_reading!r} is not one of "
+                                 f"{list(self.SWING_READINGS)}")
 
 
 @dataclass(frozen=True)

@@ -40,6 +40,38 @@ def test_window_membership(t, start, end, inside):
     assert cpg.in_torque_free_window(t, start, end) is inside
 
 
+@pytest.mark.parametrize("elapsed, fraction", [
+    (0.1, 0.0), (0.2, 1.0), (0.3, 1.0), (0.4995, 0.5), (0.1996, 0.6), (0.5, 0.0), (0.19, 0.0),
+])
+def test_torque_free_fraction_is_the_overlap_of_period_and_window(elapsed, fraction):
+    assert cpg.torque_free_fraction(elapsed, 1e-3, 0.2, 0.5) == pytest.approx(fraction, abs=1e-9)
+    assert cpg.torque_free_fraction(elapsed, 1e-3, 0.5, 0.2) == 0.0  # t2 <= t1: no window
+
+
+def test_window_edges_between_updates_scale_the_torque_by_the_part_outside():
+    """An edge inside a control period: that period's swing-hip torque is the servo's (the same walk
+    without a window) times the part of the period outside the window; whole periods are 0 or unscaled."""
+    window = TorqueFreeWindow(0.0503, 0.1203, first_step=0)
+    dt, h = 1e-3, 1e-3
+    c_w, sim_w, ctx_w = _controller_alone(EpisodeConfig(window=window))
+    c_0, sim_0, ctx_0 = _controller_alone(EpisodeConfig())
+    swing_hip = joint_index("left", "hip")
+    seen = set()
+    for k in range(1, 150):
+        t = round(k * dt, 9)
+        sim_w.AdvanceTo(t)
+        sim_0.AdvanceTo(t)
+        elapsed = t - dt + h
+        part = cpg.torque_free_fraction(elapsed, dt, window.start_s, window.end_s)
+        tau_w = c_w.get_output_port_actuation().Eval(ctx_w)[swing_hip]
+        tau_0 = c_0.get_output_port_actuation().Eval(ctx_0)[swing_hip]
+        assert abs(tau_0) > 0.1
+        assert tau_w == pytest.approx((1.0 - part) * tau_0, rel=1e-12, abs=1e-12)
+        assert c_w.state(ctx_w).torque_free == pytest.approx(part, abs=1e-12)
+        seen.add(round(part, 3))
+    assert {0.0, 1.0, 0.7, 0.3} <= seen  # both cut periods were met, and whole ones on both sides
+
+
 def _controller_alone(config):
     """The controller with a fixed plant state whose swing foot is high in the air (no touchdown)."""
     q, v, stance_right, liftoff = initial_state(config)
@@ -92,14 +124,17 @@ def test_gate_zeroes_swing_hip_and_freezes_integrator():
         sim.AdvanceTo(t)
         tau = c.get_output_port_actuation().Eval(ctx)
         s = c.state(ctx)
-        last_update = t - config.sim.control_period_s  # the torque now held was computed at this time
-        if window.start_s <= last_update - 1e-9 and last_update < window.end_s - 1e-9:
+        # the torque now held was computed at t - dt and acts over [elapsed, elapsed + dt) after T_n = 0,
+        # in plant-state time (the update reads the state one time step ahead)
+        elapsed = t - config.sim.control_period_s + config.sim.time_step_s
+        inside = window.start_s <= elapsed + 1e-9 and elapsed + config.sim.control_period_s <= window.end_s + 1e-9
+        if inside:
             assert tau[swing_hip] == 0.0
             assert s.torque_free == 1.0
             integral_at_start = s.hip_integral if integral_at_start is None else integral_at_start
             assert s.hip_integral == integral_at_start
             seen_in += 1
-        elif last_update > window.end_s + 1e-9 or last_update < window.start_s - 1e-9:
+        elif elapsed >= window.end_s - 1e-9 or elapsed + config.sim.control_period_s <= window.start_s + 1e-9:
             assert abs(tau[swing_hip]) > 0.1
             assert s.torque_free == 0.0
             seen_out += 1

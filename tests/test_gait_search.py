@@ -1,10 +1,22 @@
 """The (1 + lambda) gait search: mutation bounds, monotone parent score, resume."""
 
 import json
+import math
 import random
 
-from drake_biped.experiments.gait_search import MUTATIONS, GaitSearchSettings, _read_log, mutate, run
-from drake_biped.params import EpisodeConfig, SimulationParams
+import pytest
+
+from drake_biped.experiments import gait_search
+from drake_biped.experiments.gait_search import (
+    MUTATIONS,
+    PAPER_MUTATIONS,
+    GaitSearchSettings,
+    _read_log,
+    mutate,
+    policy_draws,
+    run,
+)
+from drake_biped.params import PAPER_CPG, EpisodeConfig, ParameterError, SimulationParams
 
 
 def test_mutation_changes_every_listed_parameter_within_bounds():
@@ -35,3 +47,66 @@ def test_search_keeps_the_best_parent_and_resumes(tmp_path, client):
     assert [r["generation"] for r in records] == [0, 1, 2, 3]
     best = EpisodeConfig.from_dict(json.loads((tmp_path / "best_config.json").read_text()))
     assert best.to_dict() == records[-1]["parent"]
+
+
+def test_paper_mutations_hold_the_cpg_and_the_initiation():
+    c = EpisodeConfig(cpg=PAPER_CPG)
+    child = mutate(c, random.Random(3), sigma=0.5, mutations=PAPER_MUTATIONS)
+    assert child.cpg == PAPER_CPG and child.initial == c.initial
+    for (section, name), (_, _, lo, hi) in PAPER_MUTATIONS.items():
+        assert section == "gait"
+        assert lo <= getattr(child.gait, name) <= hi
+        assert getattr(child.gait, name) != getattr(c.gait, name)
+
+
+def test_policy_draws_are_the_paper_start_policy():
+    draws = policy_draws(4000, seed=1)
+    t = [d for d in draws if min(d) > 0.0]  # the clipping at 0 touches about 1 % of the draws
+    assert len(t) > 0.97 * len(draws)
+    for k in (0, 1):
+        xs = [d[k] for d in t]
+        mean = sum(xs) / len(xs)
+        sd = math.sqrt(sum((x - mean) ** 2 for x in xs) / len(xs))
+        assert mean == pytest.approx(0.5, abs=0.02) and sd == pytest.approx(0.2, abs=0.01)
+    assert policy_draws() == policy_draws()  # fixed: the same windows score every candidate
+
+
+def test_a_walker_outscores_any_fall_and_a_longer_fall_a_shorter(monkeypatch):
+    walks = {}
+
+    def fake_walk(config):
+        d = walks[config.window.start_s, config.window.end_s]
+        return {"walked": d >= config.sim.distance_m, "cost_of_transport": 0.2, "distance_m": d,
+                "reward": min(d / config.sim.distance_m, 1.0) / 0.2}
+
+    monkeypatch.setattr(gait_search, "_walk", fake_walk)
+    config = EpisodeConfig(sim=SimulationParams(distance_m=6.0))
+    scores = []
+    for d in (0.5, 3.0, 6.0):
+        walks[0.0, 0.0] = d
+        scores.append(gait_search.score(config, windows=(), objective="walk")[0])
+    assert scores[0] < scores[1] < -1.0 < scores[2] == 0.0
+
+
+def test_policy_objective_is_the_expected_gain_of_the_draws(monkeypatch):
+    """Windows that all walk at half the cost double the reward of the drawn windows; draws with t2 <= t1
+    are no window: the score is mean gain + half the best gain."""
+
+    def fake_walk(config):
+        cmt = 0.1 if config.window.active else 0.2
+        return {"walked": True, "cost_of_transport": cmt, "distance_m": 6.0, "reward": 1.0 / cmt}
+
+    monkeypatch.setattr(gait_search, "_walk", fake_walk)
+    value, detail = gait_search.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="policy")
+    draws = policy_draws()
+    windowed = sum(1 for t1, t2 in draws if t2 > t1)
+    assert 0 < windowed < len(draws)
+    assert value == pytest.approx(windowed / len(draws) + 0.5)
+    assert [r["window"] for r in detail["windows"]] == [list(d) for d in draws]
+
+
+def test_unknown_search_settings_are_refused():
+    with pytest.raises(ParameterError, match="mutations"):
+        GaitSearchSettings(mutations="everything")
+    with pytest.raises(ParameterError, match="objective"):
+        GaitSearchSettings(objective="speed")

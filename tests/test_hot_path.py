@@ -37,9 +37,10 @@ def test_replay_rejects_a_malformed_log():
 
 
 def test_touchdown_records_are_the_logged_section_states(short_walk):
-    """Each recorded touchdown is the logged plant state of the update that confirmed it (inter-leg angle
-    and rate, leading minus trailing thigh; the centre of mass), carried back to the moment the swing
-    foot's clearance crossed the touchdown height, within the last control period."""
+    """Each recorded touchdown is placed at the moment the swing foot's clearance crossed the touchdown
+    height, within the control period before the update that confirmed it: the inter-leg angle (leading
+    minus trailing thigh) interpolated there between the two logged states, its rate extrapolated there
+    from the two logged states before them (before the impact), the centre of mass of the update."""
     T = short_walk.trajectory
     dt = _config().sim.control_period_s
     assert len(short_walk.steps) >= 3
@@ -51,14 +52,19 @@ def test_touchdown_records_are_the_logged_section_states(short_walk):
         backs.append(back)
         st, sw = (6, 3) if step.stance_leg == "right" else (3, 6)
         angle = T["positions"][:, st] - T["positions"][:, sw]
-        rate = T["velocities"][i, st] - T["velocities"][i, sw]
-        assert step.hip_rate_radps == pytest.approx(rate, abs=1e-9)
-        assert step.hip_angle_rad == pytest.approx(angle[i] - back * rate, abs=1e-12)
+        rate = T["velocities"][:, st] - T["velocities"][:, sw]
+        f = back / dt
+        if step.index > 1:  # the first touchdown ends the initiation, whose stance began on the ground
+            assert step.hip_rate_radps == pytest.approx(rate[i - 1] + (rate[i - 1] - rate[i - 2]) * (1 - f),
+                                                        abs=1e-9)
+            assert abs(step.hip_rate_radps - rate[i - 1]) < 0.05  # a step before, not across, the impact
+        assert step.hip_angle_rad == pytest.approx((1 - f) * angle[i] + f * angle[i - 1], abs=1e-12)
         # between the two logged states it was interpolated from (the leg rates are smooth over 1 ms)
         lo, hi = sorted((angle[i - 1], angle[i]))
         assert lo - 1e-6 <= step.hip_angle_rad <= hi + 1e-6
         assert step.com_x_m == pytest.approx(center_of_mass(T["positions"][i])[0], abs=1e-12)
         assert T["stance_right"][i] == (1.0 if step.stance_leg == "right" else 0.0)
+        assert T["step_start"][i] == step.touchdown_time_s  # the step clock counts from the crossing
     assert max(backs) > 0.0  # the crossing is placed inside the control period, not on its grid
 
 

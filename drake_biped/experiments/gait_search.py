@@ -5,10 +5,20 @@ for positive gains, Gaussian steps for angles and phases), scores every child, a
 if it scores at least as well as the parent. This is how `params.DEFAULT_CPG`/`DEFAULT_GAIT` were found
 (from a walker of an earlier random search; see README).
 
-Score of a configuration: -9 if it does not walk `distance_m` without a window; otherwise the largest
-fractional C_mt saving among the scored windows that also walk (-0.3 if none walks), plus 0.03 for every
-window that walks. Every generation is appended to `search.jsonl`; a rerun resumes from its last line.
-The children of a generation are scored in parallel on Dask (`executor`).
+Score of a configuration that does not walk `distance_m` without a window: -9 + 8 * (the fraction of the
+distance it walked), so that a search from a gait that falls climbs towards one that walks. Of one that
+walks, by the objective:
+- "windows": the largest fractional C_mt saving among the scored windows that also walk (-0.3 if none
+  walks), plus 0.03 for every window that walks;
+- "walk": 0 (the search stops improving once a walker is found; use it to find one);
+- "policy": what the paper's learner climbs from its start: the expected reward of the policy
+  N((0.5, 0.5), 0.04 I) over POLICY_DRAWS fixed draws, relative to no window (a draw with t2 <= t1 is no
+  window and takes its reward), plus half the largest gain of a single drawn window.
+
+Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
+(PAPER_MUTATIONS: the gains the paper does not print, the CPG held at what the start configuration has).
+Every generation is appended to `search.jsonl`; a rerun resumes from its last line. The children of a
+generation are scored in parallel on Dask (`executor`).
 """
 
 from __future__ import annotations
@@ -46,10 +56,46 @@ MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
 }
 
 
-def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1) -> EpisodeConfig:
-    """A child of `config`: every parameter in MUTATIONS moved by a random step scaled by sigma / 0.1."""
+# The gains the paper does not print, for a search that holds the CPG (Table III) and the initiation.
+PAPER_MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
+    ("gait", "hip_kp"): ("log", 0.1, 5.0, 2000.0),
+    ("gait", "hip_kd"): ("log", 0.1, 0.5, 200.0),
+    ("gait", "placement_gain"): ("add", 0.1, -2.0, 4.9),
+    ("gait", "placement_velocity_gain"): ("add", 0.05, -2.0, 4.9),
+    ("gait", "swing_offset_rad"): ("add", 0.05, -1.0, 1.0),
+    ("gait", "torso_kp"): ("log", 0.1, 20.0, 5000.0),
+    ("gait", "torso_kd"): ("log", 0.1, 2.0, 500.0),
+    ("gait", "torso_pitch_rad"): ("add", 0.015, -0.45, 0.1),
+    ("gait", "knee_flex_torque"): ("log", 0.1, 0.1, 30.0),
+    ("gait", "knee_extend_torque"): ("log", 0.1, 0.1, 30.0),
+    ("gait", "knee_flex_max_rad"): ("log", 0.1, 0.05, 2.4),
+    ("gait", "knee_flex_until_phase"): ("add", 0.1, 0.0, math.pi),
+    ("gait", "knee_extend_phase"): ("add", 0.1, 0.5, 3.1),
+    ("gait", "knee_extend_thigh_rad"): ("add", 0.04, -0.9, 0.9),
+    ("gait", "stance_knee_torque"): ("log", 0.1, 1.0, 30.0),
+    ("gait", "ankle_kp"): ("log", 0.1, 1.0, 400.0),
+    ("gait", "ankle_kd"): ("log", 0.1, 0.05, 40.0),
+    ("gait", "touchdown_min_phase"): ("add", 0.1, 0.3, 3.1),
+}
+MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS}
+OBJECTIVES = ("windows", "walk", "policy")
+# The paper's learner starts at (0.5, 0.5) with variance 0.04 (Table II): fixed draws of that policy.
+POLICY_START, POLICY_VARIANCE, POLICY_DRAWS = (0.5, 0.5), 0.04, 12
+
+
+def policy_draws(count: int = POLICY_DRAWS, seed: int = 0) -> list[tuple[float, float]]:
+    """`count` fixed draws (t1, t2) of the paper's starting policy, times below 0 taken as 0."""
+    rng = random.Random(seed)
+    sd = math.sqrt(POLICY_VARIANCE)
+    return [(round(max(0.0, rng.gauss(POLICY_START[0], sd)), 6), round(max(0.0, rng.gauss(POLICY_START[1], sd)), 6))
+            for _ in range(count)]
+
+
+def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1, mutations=None) -> EpisodeConfig:
+    """A child of `config`: every parameter in `mutations` (default MUTATIONS) moved by a random step
+    scaled by sigma / 0.1."""
     sections = {"cpg": config.cpg.to_dict(), "gait": config.gait.to_dict()}
-    for (section, name), (kind, step, lo, hi) in MUTATIONS.items():
+    for (section, name), (kind, step, lo, hi) in (MUTATIONS if mutations is None else mutations).items():
         value = sections[section][name]
         if kind == "log":
             value = value * math.exp(rng.gauss(0.0, step * sigma / 0.1))
@@ -62,6 +108,7 @@ def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1) -> Epi
 
 
 def _walk(config: EpisodeConfig) -> dict[str, Any]:
+    from drake_biped.analysis.reward import reward
     from drake_biped.episode import run_episode
 
     r = run_episode(config)
@@ -69,28 +116,41 @@ def _walk(config: EpisodeConfig) -> dict[str, Any]:
         "walked": (not r.fell) and r.distance_m >= config.sim.distance_m - 1e-6,
         "cost_of_transport": r.cost_of_transport,
         "distance_m": r.distance_m,
+        "reward": reward(r.cost_of_transport, r.distance_m, config.sim.distance_m),
     }
 
 
-def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS) -> tuple[float, dict[str, Any]]:
+def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows") -> tuple[float, dict[str, Any]]:
     """The search objective (module docstring) and what it measured."""
     base = _walk(config.replace(window=TorqueFreeWindow()))
     if not base["walked"]:
-        return -9.0, {"baseline": base, "windows": []}
+        return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
+            {"baseline": base, "windows": []}
+    if objective == "walk":
+        return 0.0, {"baseline": base, "windows": []}
+    if objective == "policy":
+        windows = policy_draws()
     rows = []
     for t1, t2 in windows:
-        row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
+        if t2 <= t1:
+            row = dict(base)
+        else:
+            row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
         row["window"] = [t1, t2]
         rows.append(row)
+    if objective == "policy":
+        gains = [r["reward"] / base["reward"] - 1.0 for r in rows]
+        value = sum(gains) / len(gains) + 0.5 * max(0.0, max(gains))
+        return value, {"baseline": base, "windows": rows}
     savings = [1.0 - r["cost_of_transport"] / base["cost_of_transport"] for r in rows if r["walked"]]
     value = (max(savings) if savings else -0.3) + 0.03 * len(savings)
     return value, {"baseline": base, "windows": rows}
 
 
 def _child(args) -> tuple[dict, float, dict]:
-    parent_dict, seed, sigma, windows = args
-    child = mutate(EpisodeConfig.from_dict(parent_dict), random.Random(seed), sigma)
-    value, detail = score(child, windows)
+    parent_dict, seed, sigma, windows, mutations, objective = args
+    child = mutate(EpisodeConfig.from_dict(parent_dict), random.Random(seed), sigma, MUTATION_SETS[mutations])
+    value, detail = score(child, windows, objective)
     return child.to_dict(), value, detail
 
 
@@ -105,8 +165,14 @@ class GaitSearchSettings:
     seed: int = 0
     distance_m: float = 6.0
     windows: tuple[tuple[float, float], ...] = ACCEPTANCE_WINDOWS
+    mutations: str = "default"
+    objective: str = "windows"
 
     def __post_init__(self) -> None:
+        if self.mutations not in MUTATION_SETS:
+            raise ParameterError(f"mutations {self.mutations!r} is not one of {sorted(MUTATION_SETS)}")
+        if self.objective not in OBJECTIVES:
+            raise ParameterError(f"objective {self.objective!r} is not one of {list(OBJECTIVES)}")
         if self.generations < 1 or self.offspring < 1 or not self.sigma > 0 or not self.distance_m > 0:
             raise ParameterError(
                 f"generations ({self.generations!r}) and offspring ({self.offspring!r}) must be >= 1, "
@@ -135,9 +201,10 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
             parent, parent_score, first = last["parent"], last["parent_score"], last["generation"] + 1
         else:
             parent = start.to_dict()
-            parent_score, detail = c.submit(score, start, windows, pure=False).result()
+            parent_score, detail = c.submit(score, start, windows, settings.objective, pure=False).result()
             _append(log, {"generation": 0, "parent": parent, "parent_score": parent_score, "detail": detail,
-                          "seed": seed, "sigma": sigma, "versions": versions()})
+                          "seed": seed, "sigma": sigma, "mutations": settings.mutations,
+                          "objective": settings.objective, "versions": versions()})
         if progress:
             from tqdm import tqdm
 
@@ -145,8 +212,8 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
                        unit="gen")
         try:
             for gen in range(first, settings.generations + 1):
-                jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows)
-                        for k in range(settings.offspring)]
+                jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows, settings.mutations,
+                         settings.objective) for k in range(settings.offspring)]
                 children = map_ordered(c, _child, jobs)
                 best_dict, best_score, best_detail = max(children, key=lambda ch: ch[1])
                 if best_score >= parent_score:
