@@ -139,3 +139,36 @@ def test_gate_zeroes_swing_hip_and_freezes_integrator():
             assert s.torque_free == 0.0
             seen_out += 1
     assert seen_in >= 60 and seen_out >= 100
+
+
+def test_integrated_reading_drives_the_swing_by_zeta_unscaled():
+    """Under the integrated reading, without placement feedback, the swing reference is the lift-off
+    angle plus the integral of zeta, and the servo's rate reference is zeta: recovered from the hip torque
+    of the controller on a fixed plant state (the thigh at rest)."""
+    from drake_biped.params import PAPER_CPG, GaitParams
+
+    gait = GaitParams(swing_reading="integrated", placement_gain=0.0, placement_velocity_gain=0.0,
+                      swing_offset_rad=0.0, hip_kp=80.0, hip_kd=9.0, hip_ki=0.0)
+    config = EpisodeConfig(cpg=PAPER_CPG.__class__(**{**PAPER_CPG.to_dict(), "kappa": 0.0}), gait=gait)
+    c, sim, ctx = _controller_alone(config)
+    x = c.get_input_port_plant_state().Eval(ctx)
+    q = x[:9]
+    thigh = q[2] + q[3]  # the left (swing) thigh's world angle
+    liftoff = c.state(ctx).liftoff_angle_rad
+    dt = config.sim.control_period_s
+    travel = 0.0
+    swing_hip = joint_index("left", "hip")
+    read = 0
+    for k in range(1, 400):
+        sim.AdvanceTo(round(k * dt, 9))
+        gamma = c.state(ctx).cpg_phase
+        zeta = cpg.output(config.cpg, gamma)
+        travel += dt * zeta
+        tau = c.get_output_port_actuation().Eval(ctx)[swing_hip]
+        if abs(tau) < 39.0:  # below the torque limit the PID's terms can be read back
+            reference = thigh + (tau - gait.hip_kd * zeta) / gait.hip_kp
+            assert reference - liftoff == pytest.approx(travel, abs=1e-9)
+            read += 1
+    assert read > 150
+    assert travel == pytest.approx(PAPER_CPG.u_a * (1 - math.cos(min(math.pi, 399 * dt * PAPER_CPG.u_r)))
+                                   / PAPER_CPG.u_r, abs=0.01)
