@@ -78,8 +78,14 @@ def roughness(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.sqrt(np.mean((y - fit) ** 2)) / span)
 
 
+def distinct(y) -> int:
+    """How many different values the response takes (to 1e-9): a staircase takes few."""
+    return len({round(float(v), 9) for v in y if v is not None})
+
+
 def response(x: np.ndarray, y: np.ndarray) -> dict:
-    return {"slope": float(np.polyfit(x, y, 1)[0]), "range": float(np.ptp(y)), "roughness": roughness(x, y)}
+    return {"slope": float(np.polyfit(x, y, 1)[0]), "range": float(np.ptp(y)), "roughness": roughness(x, y),
+            "distinct": distinct(y)}
 
 
 def sweep(tree: Path, workers: int) -> dict:
@@ -114,12 +120,15 @@ LABELS = {
 
 
 def compare(before: dict, after: dict) -> str:
-    lines = ["| response | before: slope | before: roughness | after: slope | after: roughness |",
-             "|---|---:|---:|---:|---:|"]
+    lines = ["| response | before: slope | roughness | distinct values | after: slope | roughness | distinct values |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
     for key, label in LABELS.items():
-        b, a = before["responses"][key], after["responses"][key]
-        lines.append(f"| {label} | {b.get('slope', float('nan')):.4g} | {b.get('roughness', float('nan')):.3f} | "
-                     f"{a.get('slope', float('nan')):.4g} | {a.get('roughness', float('nan')):.3f} |")
+        cells = []
+        for rec in (before, after):
+            r = rec["responses"][key]
+            cells += [f"{r.get('slope', float('nan')):.4g}", f"{r.get('roughness', float('nan')):.3f}",
+                      f"{distinct(r['values'])} of {len(r['values'])}"]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 

@@ -173,8 +173,9 @@ def cmd_gait_search(args: argparse.Namespace) -> int:
         config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
         distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
         objective=args.objective)
+    search = gait_search.run_cmaes if args.method == "cmaes" else gait_search.run
     with _client(args) as client:
-        result = gait_search.run(settings, Path(args.out), client)
+        result = search(settings, Path(args.out), client)
     print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
     return 0
 
@@ -442,6 +443,9 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--mutations", choices=["default", "paper"], default="default",
                         help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains) or 'paper' (only what "
                              "the paper does not print: the CPG and the initiation held)")
+    search.add_argument("--method", choices=["es", "cmaes"], default="es",
+                        help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
+                             "offspring candidates a generation")
     search.add_argument("--objective", choices=["windows", "walk", "policy"], default="windows",
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
                              "find a walker), 'policy' (the expected reward of the paper's start policy)")

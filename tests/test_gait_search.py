@@ -110,3 +110,29 @@ def test_unknown_search_settings_are_refused():
         GaitSearchSettings(mutations="everything")
     with pytest.raises(ParameterError, match="objective"):
         GaitSearchSettings(objective="speed")
+
+
+def test_cmaes_search_resumes_to_the_uninterrupted_result(tmp_path, client):
+    start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
+    kwargs = dict(offspring=4, sigma=0.3, seed=2, distance_m=0.3, windows=((0.1, 0.2),))
+    whole, parts = tmp_path / "whole", tmp_path / "parts"
+    gait_search.run_cmaes(GaitSearchSettings(start, generations=3, **kwargs), whole, client, progress=False)
+    gait_search.run_cmaes(GaitSearchSettings(start, generations=2, **kwargs), parts, client, progress=False)
+    gait_search.run_cmaes(GaitSearchSettings(start, generations=3, **kwargs), parts, client, progress=False)
+    a, b = _read_log(whole / "search.jsonl"), _read_log(parts / "search.jsonl")
+    assert [r["generation"] for r in b] == [1, 2, 3]
+    assert [r["child_scores"] for r in a] == [r["child_scores"] for r in b]
+    assert [r["parent"] for r in a] == [r["parent"] for r in b]
+    scores = [r["parent_score"] for r in a]
+    assert scores == sorted(scores) and scores[-1] == max(max(r["child_scores"]) for r in a)
+    best = json.loads((whole / "best_config.json").read_text())
+    assert best == a[-1]["parent"]
+
+
+def test_decode_maps_zero_to_the_start_and_stays_in_bounds():
+    start = EpisodeConfig(cpg=PAPER_CPG)
+    assert gait_search.decode(start, PAPER_MUTATIONS, [0.0] * len(PAPER_MUTATIONS)).gait == start.gait
+    far = gait_search.decode(start, PAPER_MUTATIONS, [1000.0] * len(PAPER_MUTATIONS))
+    for (_, name), (_, _, lo, hi) in PAPER_MUTATIONS.items():
+        assert getattr(far.gait, name) == hi
+    assert far.cpg == PAPER_CPG

@@ -231,6 +231,94 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
     return {"parent": parent, "score": parent_score}
 
 
+def _coordinates(start: EpisodeConfig, mutations) -> list[tuple[str, str, str, float, float, float, float]]:
+    """(section, name, kind, start value, step, lo, hi) of every searched parameter."""
+    out = []
+    for (section, name), (kind, step, lo, hi) in mutations.items():
+        value = getattr(getattr(start, section), name)
+        if kind == "log" and value <= 0.0:
+            value = max(lo, 1e-3)
+        out.append((section, name, kind, min(hi, max(lo, value)), step, lo, hi))
+    return out
+
+
+def decode(start: EpisodeConfig, mutations, x, sigma: float = 0.1) -> EpisodeConfig:
+    """The configuration at CMA-ES coordinates x (0: the start): a parameter moves by x times its mutation
+    step scaled by sigma / 0.1, in log for positive gains, within its bounds."""
+    sections = {"cpg": start.cpg.to_dict(), "gait": start.gait.to_dict()}
+    for xi, (section, name, kind, value, step, lo, hi) in zip(x, _coordinates(start, mutations)):
+        value = value * math.exp(step * sigma / 0.1 * xi) if kind == "log" else value + step * sigma / 0.1 * xi
+        sections[section][name] = min(hi, max(lo, float(value)))
+    return start.replace(cpg=type(start.cpg)(**sections["cpg"]), gait=type(start.gait)(**sections["gait"]))
+
+
+def _scored(args) -> tuple[float, dict]:
+    config_dict, windows, objective = args
+    return score(EpisodeConfig.from_dict(config_dict), windows, objective)
+
+
+def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """The same search by CMA-ES (pycma) in the coordinates of `decode`, `offspring` candidates a
+    generation (at least 4), unit initial step: `search.jsonl` (one line per generation with every
+    candidate's score, the best so far as `parent`) and `best_config.json`. The sampling is seeded from
+    (seed, generation), so a rerun resumes by replaying the logged generations into a new strategy (no
+    episode is run again) and repeats an uninterrupted search exactly."""
+    import cma
+    import numpy as np
+
+    from drake_biped.experiments.executor import client_or_local, map_ordered
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    log = out / "search.jsonl"
+    mutations = MUTATION_SETS[settings.mutations]
+    start = settings.config.replace(sim=dataclasses.replace(
+        settings.config.sim, distance_m=settings.distance_m,
+        max_time_s=max(settings.config.sim.max_time_s, 6.0 * settings.distance_m)))
+    windows = [tuple(w) for w in settings.windows]
+    es = cma.CMAEvolutionStrategy(np.zeros(len(mutations)), 1.0, {
+        "popsize": max(4, settings.offspring), "seed": settings.seed + 1, "verbose": -9, "bounds": [-6.0, 6.0]})
+
+    def ask(gen: int):
+        np.random.seed((settings.seed * 1_000_003 + gen) % 2**32)
+        return es.ask()
+
+    best, best_score, first = start.to_dict(), -math.inf, 1
+    for r in _read_log(log):
+        es.tell(ask(r["generation"]), [-v for v in r["child_scores"]])
+        best, best_score, first = r["parent"], r["parent_score"], r["generation"] + 1
+    bar = None
+    with client_or_local(client) as c:
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=settings.generations, initial=min(first - 1, settings.generations), desc="cma-es",
+                       unit="gen")
+        try:
+            for gen in range(first, settings.generations + 1):
+                xs = ask(gen)
+                configs = [decode(start, mutations, x, settings.sigma).to_dict() for x in xs]
+                results = map_ordered(c, _scored, [(cfg, windows, settings.objective) for cfg in configs])
+                scores = [r[0] for r in results]
+                es.tell(xs, [-v for v in scores])
+                k = int(np.argmax(scores))
+                if scores[k] > best_score:
+                    best, best_score = configs[k], scores[k]
+                _append(log, {"generation": gen, "parent": best, "parent_score": best_score,
+                              "best_child_score": scores[k], "child_scores": scores, "best_child_detail": results[k][1],
+                              "mean": [float(v) for v in es.mean], "step": float(es.sigma),
+                              **({"seed": settings.seed, "mutations": settings.mutations,
+                                  "objective": settings.objective, "versions": versions()} if gen == 1 else {})})
+                if bar is not None:
+                    bar.update(1)
+                    bar.set_postfix_str(f"best {best_score:+.3f}")
+        finally:
+            if bar is not None:
+                bar.close()
+    write_text_atomic(out / "best_config.json", json.dumps(best, indent=2) + "\n")
+    return {"parent": best, "score": best_score}
+
+
 def _read_log(path: Path) -> list[dict]:
     """The finished generations; a last line cut short by a kill is dropped (and rewritten away)."""
     if not path.exists():
