@@ -133,6 +133,6 @@ def test_decode_maps_zero_to_the_start_and_stays_in_bounds():
     start = EpisodeConfig(cpg=PAPER_CPG)
     assert gait_search.decode(start, PAPER_MUTATIONS, [0.0] * len(PAPER_MUTATIONS)).gait == start.gait
     far = gait_search.decode(start, PAPER_MUTATIONS, [1000.0] * len(PAPER_MUTATIONS))
-    for (_, name), (_, _, lo, hi) in PAPER_MUTATIONS.items():
+    for (_, name), (_, _, _, hi) in PAPER_MUTATIONS.items():
         assert getattr(far.gait, name) == hi
     assert far.cpg == PAPER_CPG
