@@ -440,15 +440,17 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
     search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
     search.add_argument("--sigma", type=_number("positive"), default=0.1, help="mutation scale (default 0.1)")
-    search.add_argument("--mutations", choices=["default", "paper"], default="default",
-                        help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains) or 'paper' (only what "
-                             "the paper does not print: the CPG and the initiation held)")
+    search.add_argument("--mutations", choices=["default", "paper", "near_paper"], default="default",
+                        help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
+                             "the paper does not print: the CPG and the initiation held) or 'near_paper' (those "
+                             "and u_a, u_r, kappa)")
     search.add_argument("--method", choices=["es", "cmaes"], default="es",
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
-    search.add_argument("--objective", choices=["windows", "walk", "policy"], default="windows",
+    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest"], default="windows",
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
-                             "find a walker), 'policy' (the expected reward of the paper's start policy)")
+                             "find a walker), 'policy' (the expected reward of the paper's start policy), "
+                             "'nearest' (the CPG's nearness to Table III)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

@@ -136,3 +136,13 @@ def test_decode_maps_zero_to_the_start_and_stays_in_bounds():
     for (_, name), (_, _, _, hi) in PAPER_MUTATIONS.items():
         assert getattr(far.gait, name) == hi
     assert far.cpg == PAPER_CPG
+
+
+def test_nearest_objective_prefers_the_walker_nearest_table_iii(monkeypatch):
+    monkeypatch.setattr(gait_search, "_walk", lambda config: {"walked": True, "cost_of_transport": 0.2,
+                                                              "distance_m": 6.0, "reward": 5.0})
+    near = EpisodeConfig(cpg=PAPER_CPG.__class__(u_a=2.2, u_r=2.1, kappa=1.8))
+    far = EpisodeConfig()  # the default gait's CPG: u_r 4.6
+    assert gait_search.score(EpisodeConfig(cpg=PAPER_CPG), objective="nearest")[0] == 0.0
+    assert gait_search.score(near, objective="nearest")[0] == pytest.approx(-math.log(1.1))
+    assert gait_search.score(far, objective="nearest")[0] < gait_search.score(near, objective="nearest")[0]

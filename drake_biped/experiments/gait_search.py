@@ -11,12 +11,15 @@ walks, by the objective:
 - "windows": the largest fractional C_mt saving among the scored windows that also walk (-0.3 if none
   walks), plus 0.03 for every window that walks;
 - "walk": 0 (the search stops improving once a walker is found; use it to find one);
+- "nearest": minus the CPG's distance from Table III (`distance_from_table_iii`), to find the walker whose
+  CPG is nearest the paper's (with the "near_paper" mutations);
 - "policy": what the paper's learner climbs from its start: the expected reward of the policy
   N((0.5, 0.5), 0.04 I) over POLICY_DRAWS fixed draws, relative to no window (a draw with t2 <= t1 is no
   window and takes its reward), plus half the largest gain of a single drawn window.
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
-(PAPER_MUTATIONS: the gains the paper does not print, the CPG held at what the start configuration has).
+(PAPER_MUTATIONS: the gains the paper does not print, the CPG held at what the start configuration has)
+or "near_paper" (those and the CPG's u_a, u_r, kappa).
 Every generation is appended to `search.jsonl`; a rerun resumes from its last line. The children of a
 generation are scored in parallel on Dask (`executor`).
 """
@@ -77,8 +80,23 @@ PAPER_MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
     ("gait", "ankle_kd"): ("log", 0.1, 0.05, 40.0),
     ("gait", "touchdown_min_phase"): ("add", 0.1, 0.3, 3.1),
 }
-MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy")
+# The same, with the CPG's u_a, u_r and kappa free too: for the walker nearest Table III (objective "nearest").
+NEAR_PAPER_MUTATIONS = {
+    ("cpg", "u_a"): ("log", 0.1, 0.05, 20.0),
+    ("cpg", "u_r"): ("log", 0.1, 0.5, 30.0),
+    ("cpg", "kappa"): ("log", 0.1, 0.05, 9.0),
+    **PAPER_MUTATIONS,
+}
+MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS}
+OBJECTIVES = ("windows", "walk", "policy", "nearest")
+
+
+def distance_from_table_iii(cpg) -> float:
+    """|ln(u_a / 2)| + |ln(u_r / 2.1)| + |ln(kappa / 1.8)|: how far a CPG is from Table III's, in relative
+    terms (alpha and u_eta are not searched)."""
+    from drake_biped.paper import TABLE_III
+
+    return sum(abs(math.log(getattr(cpg, k) / TABLE_III[k])) for k in ("u_a", "u_r", "kappa"))
 # The paper's learner starts at (0.5, 0.5) with variance 0.04 (Table II): fixed draws of that policy.
 POLICY_START, POLICY_VARIANCE, POLICY_DRAWS = (0.5, 0.5), 0.04, 12
 
@@ -128,6 +146,8 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
             {"baseline": base, "windows": []}
     if objective == "walk":
         return 0.0, {"baseline": base, "windows": []}
+    if objective == "nearest":
+        return -distance_from_table_iii(config.cpg), {"baseline": base, "windows": []}
     if objective == "policy":
         windows = policy_draws()
     rows = []
