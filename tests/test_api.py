@@ -89,3 +89,14 @@ def test_controller_state_is_read_by_name():
     assert CONTROLLER_STATE.rows(log, "signed_work_j").shape == (2, 6)
     with pytest.raises(AttributeError, match="no field 'gamma'"):
         view.gamma  # noqa: B018
+
+
+def test_the_paper_gait_holds_table_iii_and_the_paper_initiation_as_printed():
+    """`--params paper`: Table III's CPG and the initiation exactly, zeta driving the swing unscaled; only
+    the gains the paper does not print were searched."""
+    from drake_biped.paper import INITIAL_HIP_ANGLE_RAD, INITIAL_SPEED_MPS, TABLE_III
+
+    paper = drake_biped.load_gait("paper")
+    assert paper.cpg.to_dict() == TABLE_III
+    assert paper.initial.hip_angle_rad == INITIAL_HIP_ANGLE_RAD and paper.initial.speed_mps == INITIAL_SPEED_MPS
+    assert paper.gait.swing_reading == "integrated"
