@@ -202,7 +202,8 @@ def cmd_learn(args: argparse.Namespace) -> int:
     config = _episode_config(args)
     settings = learning.LearningSettings(config, args.trials, args.episodes,
                                          args.seed if args.seed is not None else 0,
-                                         mean=tuple(args.initial_mean), variance=args.variance)
+                                         mean=tuple(args.initial_mean), variance=args.variance,
+                                         learner=args.learner)
     record_settings = settings.record()  # validated before a cluster starts
     out = Path(args.out)
     learning.check_resume(record_settings, out)
@@ -464,8 +465,12 @@ def build_parser() -> argparse.ArgumentParser:
     ts.add_argument("--out", required=True, type=_out_folder, help="output folder")
     ts.set_defaults(func=cmd_time_step_study)
 
-    learn = sub.add_parser("learn", help="GARB learning of the torque-free period (Experiment 1), on Dask")
+    learn = sub.add_parser("learn", help="learning of the torque-free period (Experiment 1: GARB), on Dask")
     _add_episode_options(learn)
+    from drake_biped.learners import LEARNERS
+
+    learn.add_argument("--learner", choices=sorted(LEARNERS), default="garb",
+                       help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
     learn.add_argument("--trials", type=_count, default=5, help="independent trials (default 5)")
     learn.add_argument("--episodes", type=_count, default=500, help="episodes per trial (default 500)")
     learn.add_argument("--initial-mean", type=_number("nonnegative"), nargs=2, default=[0.5, 0.5],

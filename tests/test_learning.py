@@ -61,6 +61,29 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
     assert {"t1", "t2", "reward", "cost_of_transport", "distance_m", "fell"} <= set(first[0])
 
 
+@pytest.mark.parametrize("learner", ["cmaes", "pgpe"])
+def test_every_learner_resumes_to_the_uninterrupted_result(tmp_path, learner):
+    """Cut inside a CMA-ES generation (6 samples) and inside a PGPE pair: the same records as GARB's, and
+    the resumed run ends identical to the uninterrupted one."""
+    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    settings = make_settings(config, 1, 7, seed=3, learner=learner)
+    with dask_client(workers=1) as client:
+        whole, _ = run_learning(tmp_path / "whole", settings, client)
+        run_learning(tmp_path / "cut", settings, client, stop_after=3)
+        resumed, n_rest = run_learning(tmp_path / "cut", settings, client)
+    assert n_rest == 4
+    assert _episodes(tmp_path / "cut") == _episodes(tmp_path / "whole")
+    assert whole[0].learner.state() == resumed[0].learner.state()
+    rows = _episodes(tmp_path / "whole")[0]
+    assert {"t1", "t2", "mean_t1", "mean_t2", "reward", "cost_of_transport", "distance_m", "fell"} <= set(rows[0])
+    assert (rows[-1]["mean_t1"], rows[-1]["mean_t2"]) != (0.5, 0.5)  # a generation / pairs were told
+
+
+def test_an_unknown_learner_is_refused_before_anything_runs():
+    with pytest.raises(ParameterError, match="--learner 'sgd'"):
+        make_settings(EpisodeConfig(), 1, 1, seed=0, learner="sgd")
+
+
 def test_resuming_with_other_settings_is_refused(tmp_path):
     settings = _settings()
     (tmp_path / "trials").mkdir()

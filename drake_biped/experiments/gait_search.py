@@ -279,8 +279,8 @@ def _scored(args) -> tuple[float, dict]:
 
 def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """The same search by CMA-ES (pycma) in the coordinates of `decode`, `offspring` candidates a
-    generation (at least 4), unit initial step: `search.jsonl` (one line per generation with every
-    candidate's score, the best so far as `parent`) and `best_config.json`. The sampling is seeded from
+    generation (at least 4), unit initial step: `search.jsonl` (generation 0 scores the start; then one line
+    per generation with every candidate's score, the best so far as `parent`) and `best_config.json`. The sampling is seeded from
     (seed, generation), so a rerun resumes by replaying the logged generations into a new strategy (no
     episode is run again) and repeats an uninterrupted search exactly."""
     import cma
@@ -303,12 +303,20 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
         np.random.seed((settings.seed * 1_000_003 + gen) % 2**32)
         return es.ask()
 
-    best, best_score, first = start.to_dict(), -math.inf, 1
-    for r in _read_log(log):
+    records = _read_log(log)
+    for r in records[1:]:
         es.tell(ask(r["generation"]), [-v for v in r["child_scores"]])
-        best, best_score, first = r["parent"], r["parent_score"], r["generation"] + 1
+    if records:
+        best, best_score, first = records[-1]["parent"], records[-1]["parent_score"], records[-1]["generation"] + 1
     bar = None
     with client_or_local(client) as c:
+        if not records:  # generation 0: the start itself, the best so far until a candidate beats it
+            best = start.to_dict()
+            best_score, detail = c.submit(score, start, windows, settings.objective, pure=False).result()
+            first = 1
+            _append(log, {"generation": 0, "parent": best, "parent_score": best_score, "detail": detail,
+                          "seed": settings.seed, "sigma": settings.sigma, "mutations": settings.mutations,
+                          "objective": settings.objective, "method": "cmaes", "versions": versions()})
         if progress:
             from tqdm import tqdm
 
@@ -326,9 +334,7 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
                     best, best_score = configs[k], scores[k]
                 _append(log, {"generation": gen, "parent": best, "parent_score": best_score,
                               "best_child_score": scores[k], "child_scores": scores, "best_child_detail": results[k][1],
-                              "mean": [float(v) for v in es.mean], "step": float(es.sigma),
-                              **({"seed": settings.seed, "mutations": settings.mutations,
-                                  "objective": settings.objective, "versions": versions()} if gen == 1 else {})})
+                              "mean": [float(v) for v in es.mean], "step": float(es.sigma)})
                 if bar is not None:
                     bar.update(1)
                     bar.set_postfix_str(f"best {best_score:+.3f}")

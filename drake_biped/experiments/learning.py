@@ -1,6 +1,8 @@
-"""A learning run (Experiment 1): trials x episodes of GARB learning the torque-free period, on Dask.
+"""A learning run (Experiment 1): trials x episodes of a learner (GARB by default) learning the torque-free
+period, on Dask.
 
-Each trial is a GarbLearner with its own seed; its episodes are sequential (episode i+1 samples from the
+Each trial is a learner (`drake_biped.learners`: "garb", "cmaes", "pgpe" or a registered one) with its own
+seed; its episodes are sequential (episode i+1 samples from the
 policy that episode i updated). Trials run in parallel: the driver (this process) holds the learners and
 submits one episode task per trial at a time, each as soon as that trial's previous episode is recorded,
 so the workers stay busy whatever the number of trials. Workers receive EpisodeConfig dictionaries.
@@ -33,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.reward import reward
-from drake_biped.learners.garb import GarbLearner
+from drake_biped.learners import GarbLearner, learner_from_state, make_learner
 from drake_biped.paper import (
     GARB_BETA,
     GARB_MEAN_S,
@@ -64,8 +66,22 @@ def window_of(sample: np.ndarray) -> TorqueFreeWindow:
 
 def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
     """The settings a trial's record must share with the command resuming it: all but how many trials and
-    episodes (a run may be extended; the schedule depends on the episode number only)."""
-    return {k: v for k, v in settings.items() if k not in ("trials", "episodes")}
+    episodes (a run may be extended; the schedule depends on the episode number only). Records that name no
+    learner are GARB's."""
+    fixed = {k: v for k, v in settings.items() if k not in ("trials", "episodes")}
+    if "learner" in fixed and "name" not in fixed["learner"]:
+        fixed["learner"] = {"name": "garb", "options": {}, **fixed["learner"]}
+    return fixed
+
+
+def new_learner(learner_settings: dict[str, Any], seed: int):
+    """The learner of a run's settings["learner"] (make_settings), seeded `seed`."""
+    ls = learner_settings
+    name = ls.get("name", "garb")
+    options = dict(ls.get("options", {}))
+    if name == "garb":
+        options.update(beta=ls["beta"], schedule=[tuple(b) for b in ls["schedule"]])
+    return make_learner(name, ls["mean"], ls["variance"], seed=seed, **options)
 
 
 class Trial:
@@ -85,15 +101,13 @@ class Trial:
                     "use another --out, or the original options to resume"
                 )
             self.episodes: list[dict[str, Any]] = record["episodes"]
-            self.learner = GarbLearner.from_state(record["learner"])
+            self.learner = learner_from_state(record["learner"])
         elif start is not None:  # a new run from a learned policy (the slope experiment)
             self.episodes = []
             self.learner = GarbLearner.from_state(start).restarted(seed=trial_seed(settings["seed"], index))
         else:
             self.episodes = []
-            ls = settings["learner"]
-            self.learner = GarbLearner(ls["mean"], ls["variance"], ls["beta"], [tuple(b) for b in ls["schedule"]],
-                                       seed=trial_seed(settings["seed"], index))
+            self.learner = new_learner(settings["learner"], trial_seed(settings["seed"], index))
         self.pending: np.ndarray | None = None
 
     def _read_record(self) -> dict[str, Any]:
@@ -102,7 +116,7 @@ class Trial:
                   "seed gives the same episodes; the other trials are kept)")
         try:
             record = json.loads(self.path.read_text())
-            GarbLearner.from_state(record["learner"])
+            learner_from_state(record["learner"])
             record["episodes"][:0]
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise ParameterError(f"{self.path}: not valid JSON ({exc}); {remedy}") from None
@@ -116,14 +130,14 @@ class Trial:
 
     def next_config(self) -> dict[str, Any]:
         """Sample the next episode's window; its EpisodeConfig as a dictionary for a worker."""
-        self.pending = self.learner.sample()
+        self.pending = self.learner.ask()
         return self.config.replace(window=window_of(self.pending), seed=self.settings["seed"]).to_dict()
 
     def record(self, result: dict[str, Any]) -> dict[str, Any]:
         """Update the learner with the finished episode and write the trial's record."""
         sample, self.pending = self.pending, None
         r = reward(result["cost_of_transport"], result["distance_m"], self.config.sim.distance_m)
-        self.learner.update(sample, r)
+        self.learner.tell(sample, r)
         row = {
             "episode": self.done + 1,
             "t1": float(sample[0]),
@@ -131,7 +145,7 @@ class Trial:
             "mean_t1": float(self.learner.mean[0]),
             "mean_t2": float(self.learner.mean[1]),
             "reward": r,
-            "baseline": self.learner.baseline,
+            **self.learner.info(),
             "cost_of_transport": result["cost_of_transport"],
             "distance_m": result["distance_m"],
             "fell": result["fell"],
@@ -148,7 +162,8 @@ class Trial:
 
 
 def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
-                  mean=(0.5, 0.5), variance: float = 0.04, beta: float = 0.8, schedule=TABLE_II) -> dict[str, Any]:
+                  mean=(0.5, 0.5), variance: float = 0.04, beta: float = 0.8, schedule=TABLE_II,
+                  learner: str = "garb", options: dict[str, Any] | None = None) -> dict[str, Any]:
     if not isinstance(trials, int) or trials < 1:
         raise ParameterError(f"--trials {trials!r}: must be an integer >= 1")
     if not isinstance(episodes, int) or episodes < 1:
@@ -156,13 +171,20 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
     if not isinstance(seed, int) or seed < 0:
         raise ParameterError(f"--seed {seed!r}: must be an integer >= 0")
     GarbLearner(mean, variance, beta, schedule)  # validates
+    learner_settings = {"mean": list(map(float, mean)), "variance": float(variance), "beta": float(beta),
+                        "schedule": [list(b) for b in schedule]}
+    if learner != "garb" or options:
+        learner_settings.update(name=learner, options=dict(options or {}))
+        try:
+            new_learner(learner_settings, 0)  # validates the name and the options
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"--learner {learner!r}: {exc}") from None
     return {
         "trials": trials,
         "episodes": episodes,
         "seed": seed,
         "config": config.replace(window=TorqueFreeWindow(0.0, 0.0)).to_dict(),
-        "learner": {"mean": list(map(float, mean)), "variance": float(variance), "beta": float(beta),
-                    "schedule": [list(b) for b in schedule]},
+        "learner": learner_settings,
     }
 
 
@@ -265,8 +287,9 @@ def learning_record(settings: dict[str, Any], trials: list[Trial], evaluation: d
 
 @dataclass(frozen=True)
 class LearningSettings:
-    """A learning run: `trials` independent GARB learners of `episodes` episodes each on `config`'s gait,
-    the policy starting at `mean` with `variance` per time (the paper's settings by default)."""
+    """A learning run: `trials` independent learners (`learner`, GARB by default, with `options`) of
+    `episodes` episodes each on `config`'s gait, the policy starting at `mean` with `variance` per time
+    (the paper's settings by default). beta and schedule are GARB's."""
 
     config: EpisodeConfig = field(default_factory=EpisodeConfig)
     trials: int = LEARNING_TRIALS
@@ -276,11 +299,14 @@ class LearningSettings:
     variance: float = GARB_VARIANCE_S2
     beta: float = GARB_BETA
     schedule: tuple[tuple[int | None, float], ...] = TABLE_II
+    learner: str = "garb"
+    options: dict[str, Any] = field(default_factory=dict)
 
     def record(self) -> dict[str, Any]:
         """The settings as every trial record and learning.json hold them (`make_settings`)."""
         return make_settings(self.config, self.trials, self.episodes, self.seed, mean=tuple(self.mean),
-                             variance=self.variance, beta=self.beta, schedule=self.schedule)
+                             variance=self.variance, beta=self.beta, schedule=self.schedule,
+                             learner=self.learner, options=self.options)
 
 
 def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, progress: bool = True,

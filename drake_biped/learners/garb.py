@@ -59,6 +59,8 @@ def _check_schedule(schedule) -> tuple[tuple[int | None, float], ...]:
 class GarbLearner:
     """Gaussian policy over (t1, t2), updated once per episode (see the module docstring)."""
 
+    name = "garb"
+
     def __init__(
         self,
         mean: Sequence[float] = (0.5, 0.5),
@@ -101,9 +103,22 @@ class GarbLearner:
         self.mean = self.mean + learning_rate(i, self.schedule) * (reward - self.baseline) * self.trace
         self.episodes = i
 
+    def ask(self) -> np.ndarray:
+        """The learner interface's name for `sample`."""
+        return self.sample()
+
+    def tell(self, sample: Sequence[float], reward: float) -> None:
+        """The learner interface's name for `update`."""
+        self.update(sample, reward)
+
+    def info(self) -> dict[str, float]:
+        """What a learning record keeps of the learner after each episode."""
+        return {"baseline": self.baseline}
+
     def state(self) -> dict[str, Any]:
         """Everything needed to continue exactly where this learner is (JSON-serialisable)."""
         return {
+            "learner": self.name,
             "mean": self.mean.tolist(),
             "variance": self.variance,
             "beta": self.beta,
