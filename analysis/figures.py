@@ -415,3 +415,29 @@ def landscape_figure(record: dict, path) -> None:
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
     plt.close(fig)
+
+
+def learner_comparison_figure(curves: dict, record: dict, path: Path) -> Path:
+    """Learning curves side by side: each learner's running C_mt (mean over its trials), with the best
+    window's and the no-window C_mt."""
+    from drake_biped.analysis.learner_comparison import running_cost
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.0))
+    length = record["running_length"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for k, (name, trials) in enumerate(curves.items()):
+            n = min(len(t) for t in trials)
+            runs = np.array([running_cost(t[:n], length) for t in trials])
+            ax.plot(np.arange(1, n + 1), np.nanmean(runs, axis=0), color=f"C{k}", label=name)
+    ax.axhline(record["best_window"]["cost_of_transport"], color="k", ls="--", lw=0.8,
+               label=f"best window ({record['best_window']['t1']:g}, {record['best_window']['t2']:g}) s")
+    ax.axhline(record["no_window_cost_of_transport"], color="0.5", ls=":", lw=0.8, label="no window")
+    ax.set_xlabel("episode")
+    ax.set_ylabel(f"C_mt, running mean of {length} walks (mean over trials)")
+    ax.set_title("Learners side by side")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, Path(path), dpi=110)
+    plt.close(fig)
+    return Path(path)

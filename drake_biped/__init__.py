@@ -58,6 +58,8 @@ _API = {
     "Kick": "drake_biped.episode",
     # learning and analysis
     "GarbLearner": "drake_biped.learners.garb",
+    "make_learner": "drake_biped.learners.registry",
+    "register_learner": "drake_biped.learners.registry",
     "reward": "drake_biped.analysis.reward",
     "cost_of_transport": "drake_biped.analysis.cost_of_transport",
     "cost_of_transport_per_kg": "drake_biped.analysis.cost_of_transport",

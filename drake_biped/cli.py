@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | figures | landscape | stability | push-margin | grid | slope | reproduce`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | compare-learners | figures | landscape | stability | push-margin | grid | slope | reproduce`.
 
 Parsing only: each command turns its options into its experiment's settings and calls the experiment's
 `run(settings, out, client)` (drake_biped.experiments), which writes every file. Every numeric option is
@@ -196,6 +196,20 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_compare_learners(args: argparse.Namespace) -> int:
+    from drake_biped.experiments import compare_learners
+
+    settings = compare_learners.CompareSettings(
+        _episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
+        episodes=args.episodes, seed=args.seed if args.seed is not None else 0)
+    out = Path(args.out)
+    compare_learners.check(settings, out)  # before a cluster starts
+    with _client(args) as client:
+        record = compare_learners.run(settings, out, client)
+    _print(compare_learners.summary_lines(record, out))
+    return 0
+
+
 def cmd_learn(args: argparse.Namespace) -> int:
     from drake_biped.experiments import learning
 
@@ -353,6 +367,17 @@ def _steps(text: str) -> list[float]:
     return [parse(t) for t in text.split(",")]
 
 
+def _learner_names(text: str) -> list[str]:
+    from drake_biped.learners.registry import LEARNERS
+
+    names = [t.strip() for t in text.split(",")]
+    unknown = [n for n in names if n not in LEARNERS]
+    if unknown or not names or len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(f"{text!r}: a comma-separated list of distinct learners from "
+                                         f"{sorted(LEARNERS)}")
+    return names
+
+
 def _add_window_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
     p.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
@@ -395,7 +420,7 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-RESUMABLE = ("gait-search", "learn", "stability", "grid", "slope", "reproduce")
+RESUMABLE = ("gait-search", "learn", "compare-learners", "stability", "grid", "slope", "reproduce")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -467,7 +492,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     learn = sub.add_parser("learn", help="learning of the torque-free period (Experiment 1: GARB), on Dask")
     _add_episode_options(learn)
-    from drake_biped.learners import LEARNERS
+    from drake_biped.learners.registry import LEARNERS
 
     learn.add_argument("--learner", choices=sorted(LEARNERS), default="garb",
                        help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
@@ -479,6 +504,17 @@ def build_parser() -> argparse.ArgumentParser:
                        help="the policy's variance per time (s^2); default 0.04 as in the paper")
     _add_resumable_run_options(learn)
     learn.set_defaults(func=cmd_learn)
+
+    comp = sub.add_parser("compare-learners", help="learners side by side against the window map's best window")
+    _add_episode_options(comp)
+    comp.add_argument("--window-map", required=True,
+                      help="the gait's window map (a window-map folder or its window_map.json): the known optimum")
+    comp.add_argument("--learners", type=_learner_names, default=["garb", "cmaes", "pgpe"],
+                      help="comma-separated (default garb,cmaes,pgpe)")
+    comp.add_argument("--trials", type=_count, default=5, help="trials per learner (default 5)")
+    comp.add_argument("--episodes", type=_count, default=300, help="episodes per trial (default 300)")
+    _add_resumable_run_options(comp)
+    comp.set_defaults(func=cmd_compare_learners)
 
     land = sub.add_parser("landscape", help="the expected reward GARB climbs, from a window map, for given variances")
     land.add_argument("window_map", help="a window-map output folder or its window_map.json")

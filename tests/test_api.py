@@ -78,11 +78,11 @@ def test_shipped_gaits_load_by_name_or_path(tmp_path):
 def test_controller_state_is_read_by_name():
     from drake_biped.controller import CONTROLLER_STATE, N_STATE, POSITIVE_WORK, TAU
 
-    assert N_STATE == CONTROLLER_STATE.size == 37
+    assert N_STATE == CONTROLLER_STATE.size == 41
     assert CONTROLLER_STATE.slice("torques_nm") == slice(TAU, TAU + 6)
     vector = np.arange(N_STATE, dtype=float)
     view = CONTROLLER_STATE.view(vector)
-    assert view.cpg_phase == 0.0 and view.previous_clearance_m == N_STATE - 1
+    assert view.cpg_phase == 0.0 and view.swing_travel_rad == N_STATE - 1
     np.testing.assert_array_equal(view.positive_work_j, vector[POSITIVE_WORK:POSITIVE_WORK + 6])
     log = np.vstack([vector, vector + 100]).T  # two samples, as VectorLog.data() holds them
     np.testing.assert_array_equal(CONTROLLER_STATE.rows(log, "cpg_phase"), [0.0, 100.0])
@@ -100,3 +100,14 @@ def test_the_paper_gait_holds_table_iii_and_the_paper_initiation_as_printed():
     assert paper.cpg.to_dict() == TABLE_III
     assert paper.initial.hip_angle_rad == INITIAL_HIP_ANGLE_RAD and paper.initial.speed_mps == INITIAL_SPEED_MPS
     assert paper.gait.swing_reading == "integrated"
+
+
+def test_learners_from_the_top_level_api():
+    import drake_biped as db
+
+    for name in ("garb", "cmaes"):
+        learner = db.make_learner(name, mean=(0.5, 0.5), variance=0.04, seed=0)
+        t = learner.ask()
+        assert t.shape == (2,)
+        learner.tell(t, 4.0)
+        assert learner.mean.shape == (2,)

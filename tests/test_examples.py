@@ -59,3 +59,13 @@ def test_return_map(tmp_path):
 def test_dask_sweep(tmp_path):
     text = run(tmp_path, "dask_sweep.py", "--workers", "2", "--distance", "1.5")
     assert text.count("C_mt") == 6 and "no window: 1.5" in text
+
+
+@pytest.mark.slow
+def test_custom_learner(tmp_path):
+    """The registered learner is made by name and keeps the best window it has seen."""
+    text = run(tmp_path, "custom_learner.py", "--episodes", "4", "--distance", "1.5")
+    cmt = [float(x) for x in re.findall(r"C_mt (\d+\.\d+)", text)]
+    assert len(cmt) == 4 and text.count("best window so far") == 4
+    best = re.findall(r"best window so far \((\d\.\d+), (\d\.\d+)\)", text)
+    assert best[0] == ("0.300", "0.400")  # the first episode walks the start itself

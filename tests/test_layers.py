@@ -14,6 +14,7 @@ LAYERS = {
     "drake_biped.analysis.return_map": PURE,
     "drake_biped.analysis.series": PURE,
     "drake_biped.analysis.landscape": PURE,
+    "drake_biped.analysis.learner_comparison": PURE,
     "drake_biped.params": CORE,
     "drake_biped.resources": CORE,
     "drake_biped.records": CORE,
@@ -30,6 +31,9 @@ LAYERS = {
     "drake_biped.analysis.stability_report": RECORDS,
     "drake_biped.analysis.reproduce_report": RECORDS,
     "drake_biped.learners.garb": EXPERIMENTS,
+    "drake_biped.learners.cmaes": EXPERIMENTS,
+    "drake_biped.learners.pgpe": EXPERIMENTS,
+    "drake_biped.learners.registry": EXPERIMENTS,
     "drake_biped.cli": CLI,
     "drake_biped.__main__": CLI,
 }

@@ -1,6 +1,7 @@
 """The learning run: its reward rule, its records, and a run interrupted and resumed."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -150,3 +151,26 @@ def test_run_log_keeps_every_session_and_their_totals(tmp_path):
     assert [s["workers"] for s in run["sessions"]] == [2, 1]
     assert run["episodes"] == 8
     assert run["learning_wall_s"] == pytest.approx(sum(s["learning_wall_s"] for s in run["sessions"]))
+
+
+def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client):
+    from drake_biped.experiments import compare_learners, window_map
+
+    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    window_map.run(window_map.WindowMapSettings(config, t1_max_s=0.1, t2_max_s=0.3), tmp_path / "map", client,
+                   progress=False)
+    settings = compare_learners.CompareSettings(config, str(tmp_path / "map"), learners=("garb", "cmaes"),
+                                                trials=1, episodes=3)
+    record = compare_learners.run(settings, tmp_path / "cmp", client, progress=False)
+    assert set(record["learners"]) == {"garb", "cmaes"}
+    for name, row in record["learners"].items():
+        learned = json.loads((tmp_path / "cmp" / name / "learning.json").read_text())
+        assert row["episodes"] == 3 and row["trials"] == 1
+        mean = learned["trials"][0]["final_mean"]
+        best = record["best_window"]
+        assert row["mean_distance_to_best_s"] == pytest.approx(math.dist(mean, (best["t1"], best["t2"])))
+    assert (tmp_path / "cmp" / "compare.png").stat().st_size > 10_000
+    assert "| cmaes |" in (tmp_path / "cmp" / "compare.md").read_text()
+    other = compare_learners.CompareSettings(config.override({"sim.distance_m": 0.7}), str(tmp_path / "map"))
+    with pytest.raises(ParameterError, match="made for another gait"):
+        other.read_map()

@@ -35,7 +35,8 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.reward import reward
-from drake_biped.learners import GarbLearner, learner_from_state, make_learner
+from drake_biped.learners.garb import GarbLearner
+from drake_biped.learners.registry import learner_from_state, make_learner
 from drake_biped.paper import (
     GARB_BETA,
     GARB_MEAN_S,

@@ -12,45 +12,10 @@ Every learner has the same interface: `ask()` -> one (t1, t2) per episode, `tell
 A new learner is a class with that interface, added with `register_learner` (see examples/custom_learner.py).
 """
 
-from __future__ import annotations
-
-from collections.abc import Sequence
-from typing import Any
-
 from drake_biped.learners.cmaes import CmaesLearner
 from drake_biped.learners.garb import GarbLearner, learning_rate
 from drake_biped.learners.pgpe import PgpeLearner
+from drake_biped.learners.registry import LEARNERS, learner_from_state, make_learner, register_learner
 
 __all__ = ["CmaesLearner", "GarbLearner", "LEARNERS", "PgpeLearner", "learner_from_state", "learning_rate",
            "make_learner", "register_learner"]
-
-LEARNERS: dict[str, type] = {"garb": GarbLearner, "cmaes": CmaesLearner, "pgpe": PgpeLearner}
-
-
-def register_learner(cls: type) -> type:
-    """Make `cls` (with a `name`, the interface above, and __init__(mean, variance, seed, **options))
-    available to make_learner and `drake-biped learn --learner` by its name. Returns cls (a decorator)."""
-    for attr in ("name", "ask", "tell", "info", "state", "from_state"):
-        if not hasattr(cls, attr):
-            raise TypeError(f"{cls.__name__} has no {attr!r}: not a learner")
-    LEARNERS[cls.name] = cls
-    return cls
-
-
-def make_learner(name: str, mean: Sequence[float] = (0.5, 0.5), variance: float = 0.04, seed: int | None = None,
-                 **options: Any):
-    """A learner by name (module docstring), starting at `mean` with exploration variance `variance` (s^2)."""
-    try:
-        cls = LEARNERS[name]
-    except KeyError:
-        raise ValueError(f"learner {name!r} is not one of {sorted(LEARNERS)}") from None
-    return cls(mean, variance, seed=seed, **options)
-
-
-def learner_from_state(state: dict[str, Any]):
-    """The learner a `state()` was saved from (GARB for states that name none, as older records do)."""
-    name = state.get("learner", "garb")
-    try:
-        return LEARNERS[name].from_state(state)
-    except KeyError:
-        raise ValueError(f"learner {name!r} of a saved state is not one of {sorted(LEARNERS)}") from None

@@ -1,0 +1,71 @@
+"""Learners side by side against the known optimum: pure functions of learning records and a window map.
+
+The ground truth is the window map's best walking window (lowest C_mt among the windows that walk). For a
+learning run (a learning.json record) and that window:
+- final C_mt: the mean over trials of the evaluated final policy means that walk, and its reduction against
+  no window;
+- distance: of each trial's final mean to the best window (s), its mean;
+- episodes to within 5 %: the first episode at which the trial's running C_mt (the mean over the last
+  RUNNING episodes that walked) is within 5 % of the best window's; None where it never is;
+- falls: episodes that fell, summed over trials.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["RUNNING", "best_walking_window", "compare", "episodes_to_within", "running_cost"]
+
+RUNNING = 20
+
+
+def best_walking_window(window_map: dict[str, Any]) -> dict[str, Any]:
+    """The row of a window_map.json record with the lowest C_mt among the windows that walk."""
+    rows = [r for r in window_map["windows"] if r["walked"] and r["cost_of_transport"]]
+    if not rows:
+        raise ValueError("no window of the map walks: there is no best window to compare with")
+    return min(rows, key=lambda r: r["cost_of_transport"])
+
+
+def running_cost(episodes: list[dict[str, Any]], length: int = RUNNING) -> np.ndarray:
+    """Per episode, the mean C_mt of the last `length` episodes that walked (NaN before the first)."""
+    out = np.full(len(episodes), math.nan)
+    recent: list[float] = []
+    for i, e in enumerate(episodes):
+        if not e["fell"] and e["cost_of_transport"]:
+            recent = (recent + [e["cost_of_transport"]])[-length:]
+        if recent:
+            out[i] = float(np.mean(recent))
+    return out
+
+
+def episodes_to_within(episodes: list[dict[str, Any]], target: float, tolerance: float = 0.05,
+                       length: int = RUNNING) -> int | None:
+    """The first episode (1-based) whose running C_mt is within `tolerance` of `target`, else None."""
+    running = running_cost(episodes, length)
+    hits = np.flatnonzero(running <= target * (1.0 + tolerance))
+    return int(hits[0]) + 1 if len(hits) else None
+
+
+def compare(record: dict[str, Any], best: dict[str, Any], tolerance: float = 0.05) -> dict[str, Any]:
+    """One learner's row (module docstring) from its learning record and the best window's map row."""
+    target = float(best["cost_of_transport"])
+    ev = record["evaluation"]
+    means = np.array([t["final_mean"] for t in record["trials"]], dtype=float)
+    distance = np.linalg.norm(means - np.array([best["t1"], best["t2"]]), axis=1)
+    reach = [episodes_to_within(t["episodes"], target, tolerance) for t in record["trials"]]
+    return {
+        "final_cost_of_transport": ev.get("learned_mean_cost_of_transport"),
+        "reduction": ev.get("reduction"),
+        "learned_walks": ev.get("learned_walks"),
+        "trials": len(record["trials"]),
+        "mean_distance_to_best_s": float(np.mean(distance)),
+        "distance_to_best_s": distance.tolist(),
+        "episodes_to_within": reach,
+        "reached": sum(r is not None for r in reach),
+        "falls": int(sum(e["fell"] for t in record["trials"] for e in t["episodes"])),
+        "episodes": int(sum(len(t["episodes"]) for t in record["trials"])),
+    }

@@ -1,0 +1,132 @@
+"""Learners side by side (`drake-biped compare-learners`): each learner over the same trials x episodes of
+the same gait from the same start, against the window map's best walking window (the known optimum).
+
+Each learner's run is an ordinary learning run in OUT/NAME/ (the same records, figures and resume as
+`drake-biped learn --learner NAME`); OUT/compare.json, compare.md and compare.png put them side by side
+(`drake_biped.analysis.learner_comparison`). Rerunning the same command resumes every unfinished run.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from drake_biped.analysis.learner_comparison import RUNNING, best_walking_window, compare
+from drake_biped.paper import GARB_MEAN_S, GARB_VARIANCE_S2
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.records import read_json, write_atomic, write_text_atomic
+from drake_biped.versions import versions
+
+__all__ = ["CompareSettings", "run", "summary_lines"]
+
+
+@dataclass(frozen=True)
+class CompareSettings:
+    """The gait, its window map (a folder or its window_map.json), the learners and the common budget."""
+
+    config: EpisodeConfig
+    window_map: str
+    learners: tuple[str, ...] = ("garb", "cmaes", "pgpe")
+    trials: int = 5
+    episodes: int = 300
+    seed: int = 0
+    mean: tuple[float, float] = GARB_MEAN_S
+    variance: float = GARB_VARIANCE_S2
+
+    def map_path(self) -> Path:
+        source = Path(self.window_map)
+        return source / "window_map.json" if source.is_dir() else source
+
+    def read_map(self) -> dict[str, Any]:
+        """The window map, refused (ParameterError naming it) if missing or made for another gait."""
+        path = self.map_path()
+        if not path.is_file():
+            raise ParameterError(f"--window-map {self.window_map}: no window_map.json there (run drake-biped "
+                                 "window-map with the same --params first)")
+        record = read_json(path, "--window-map")
+        try:
+            made = EpisodeConfig.from_dict(record["config"])
+        except (KeyError, TypeError) as exc:
+            raise ParameterError(f"--window-map {path}: not a window map ({exc})") from None
+        mine = self.config.replace(window=TorqueFreeWindow())
+        if made.replace(window=TorqueFreeWindow()) != mine:
+            raise ParameterError(f"--window-map {path} was made for another gait or episode settings than "
+                                 "these learners walk; map this gait (same --params, --distance, ...)")
+        return record
+
+
+def _learning_settings(settings: CompareSettings, name: str):
+    from drake_biped.experiments.learning import LearningSettings
+
+    return LearningSettings(settings.config, settings.trials, settings.episodes, settings.seed,
+                            mean=tuple(settings.mean), variance=settings.variance, learner=name)
+
+
+def check(settings: CompareSettings, out: Path) -> None:
+    """Everything a run would refuse, before a cluster starts: the map, the learners, damaged records."""
+    from drake_biped.experiments import learning
+
+    settings.read_map()
+    for name in settings.learners:
+        learning.check_resume(_learning_settings(settings, name).record(), Path(out) / name)
+
+
+def run(settings: CompareSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """Run (or resume) every learner on `client` (a LocalCluster when None); write compare.json, .md and
+    .png into `out`; return the record."""
+    from drake_biped.analysis.figures import learner_comparison_figure
+    from drake_biped.experiments import learning
+    from drake_biped.experiments.executor import client_or_local
+
+    out = Path(out)
+    wmap = settings.read_map()
+    best = best_walking_window(wmap)
+    rows, curves = {}, {}
+    with client_or_local(client) as c:
+        for name in settings.learners:
+            record = learning.run(_learning_settings(settings, name), out / name, c, progress=progress)
+            wall = json.loads((out / name / "run.json").read_text())["learning_wall_s"]
+            rows[name] = {**compare(record, best), "wall_s": wall}
+            curves[name] = [t["episodes"] for t in record["trials"]]
+    record = {
+        "settings": {"learners": list(settings.learners), "trials": settings.trials, "episodes": settings.episodes,
+                     "seed": settings.seed, "mean": list(settings.mean), "variance": settings.variance,
+                     "window_map": str(settings.map_path()), "config": settings.config.to_dict()},
+        "best_window": {k: best[k] for k in ("t1", "t2", "cost_of_transport", "cmt_change")},
+        "no_window_cost_of_transport": wmap["baseline"]["cost_of_transport"],
+        "running_length": RUNNING,
+        "learners": rows,
+        "versions": versions(),
+    }
+    write_atomic(out / "compare.json", record)
+    write_text_atomic(out / "compare.md", markdown(record))
+    learner_comparison_figure(curves, record, out / "compare.png")
+    return record
+
+
+def _cell(value, fmt: str) -> str:
+    return "—" if value is None else format(value, fmt)
+
+
+def markdown(record: dict[str, Any]) -> str:
+    best = record["best_window"]
+    s = record["settings"]
+    lines = [f"Best walking window of the map: ({best['t1']:g}, {best['t2']:g}) s, C_mt {best['cost_of_transport']:.4f} "
+             f"(no window {record['no_window_cost_of_transport']:.4f}); {s['trials']} trials × {s['episodes']} "
+             f"episodes from ({s['mean'][0]:g}, {s['mean'][1]:g}), variance {s['variance']:g} s².", "",
+             "| learner | final C_mt | reduction | final means that walk | distance to best (s) | "
+             "trials within 5 % (episode) | falls | wall (min) |",
+             "|---|---:|---:|---:|---:|---|---:|---:|"]
+    for name, r in record["learners"].items():
+        reach = ", ".join("—" if e is None else str(e) for e in r["episodes_to_within"])
+        lines.append(f"| {name} | {_cell(r['final_cost_of_transport'], '.4f')} | "
+                     f"{_cell(None if r['reduction'] is None else 100 * r['reduction'], '+.1f')} % | "
+                     f"{r['learned_walks']}/{r['trials']} | {r['mean_distance_to_best_s']:.3f} | "
+                     f"{r['reached']}/{r['trials']} ({reach}) | {r['falls']}/{r['episodes']} | {r['wall_s'] / 60:.1f} |")
+    return "\n".join(lines) + "\n"
+
+
+def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
+    return [markdown(record), f"wrote {out}/compare.json, compare.md, compare.png and one learning run per learner"]

@@ -1,0 +1,50 @@
+"""The learner comparison's numbers on records whose answers are known."""
+
+import math
+
+import pytest
+
+from drake_biped.analysis.learner_comparison import (
+    best_walking_window,
+    compare,
+    episodes_to_within,
+    running_cost,
+)
+
+
+def _episode(cmt, fell=False):
+    return {"cost_of_transport": cmt, "fell": fell}
+
+
+def test_best_walking_window_ignores_falls():
+    wmap = {"windows": [{"t1": 0.1, "t2": 0.4, "walked": False, "cost_of_transport": 0.05},
+                        {"t1": 0.2, "t2": 0.5, "walked": True, "cost_of_transport": 0.16},
+                        {"t1": 0.3, "t2": 0.6, "walked": True, "cost_of_transport": 0.21}]}
+    assert best_walking_window(wmap)["t1"] == 0.2
+    with pytest.raises(ValueError, match="no window of the map walks"):
+        best_walking_window({"windows": wmap["windows"][:1]})
+
+
+def test_running_cost_averages_the_last_walks_and_skips_falls():
+    eps = [_episode(0.3), _episode(0.05, fell=True), _episode(0.1)]
+    r = running_cost(eps, length=2)
+    assert r[0] == 0.3 and r[1] == 0.3 and r[2] == pytest.approx(0.2)
+    assert math.isnan(running_cost([_episode(None, fell=True)])[0])
+
+
+def test_episodes_to_within_is_the_first_hit():
+    eps = [_episode(0.30)] * 3 + [_episode(0.16)] * 10
+    assert episodes_to_within(eps, 0.16, length=1) == 4
+    assert episodes_to_within(eps, 0.16, length=3) == 6  # (0.16 * 3) / 3 from episode 6
+    assert episodes_to_within(eps, 0.10, length=1) is None
+
+
+def test_compare_measures_distance_and_falls():
+    best = {"t1": 0.2, "t2": 0.5, "cost_of_transport": 0.16}
+    record = {"evaluation": {"learned_mean_cost_of_transport": 0.17, "reduction": 0.23, "learned_walks": 2},
+              "trials": [{"final_mean": [0.2, 0.8], "episodes": [_episode(0.2), _episode(0.1, fell=True)]},
+                         {"final_mean": [0.5, 0.9], "episodes": [_episode(0.16), _episode(0.16)]}]}
+    row = compare(record, best)
+    assert row["distance_to_best_s"] == pytest.approx([0.3, 0.5])
+    assert row["falls"] == 1 and row["episodes"] == 4
+    assert row["episodes_to_within"] == [None, 1] and row["reached"] == 1
