@@ -194,13 +194,16 @@ class CpgWalkingController(LeafSystem):
         stance_right: bool | None = None,
         liftoff_angle: float | None = None,
         pitch: float = 0.0,
+        phase: float = 0.0,
     ) -> None:
-        """Seed the work integrator's previous angles (and the torso pitch), the centre-of-mass x and the
-        distance to walk, and (when given) the first stance leg and the swing thigh's lift-off angle."""
+        """Seed the work integrator's previous angles (and the torso pitch), the centre-of-mass x, the
+        distance to walk and the CPG phase of the first swing, and (when given) the first stance leg and the
+        swing thigh's lift-off angle."""
         s = context.get_mutable_discrete_state(self._state_group)
         s.SetAtIndex(COM_X, com_x)
         s.SetAtIndex(TARGET_X, com_x + distance_m)
         s.SetAtIndex(PREV_PITCH, pitch)
+        s.SetAtIndex(GAMMA, phase)
         for i in range(6):
             s.SetAtIndex(Q_PREV + i, float(joint_angles[i]))
         if stance_right is not None:

@@ -211,7 +211,7 @@ def simulate(
     com_x0 = center_of_mass(q0, parts.masses)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
     parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
-                                      pitch=q0[2])
+                                      pitch=q0[2], phase=config.initial.cpg_phase_rad)
     group = parts.controller.state_group
     if progress is not None:
         next_report = [0.0]

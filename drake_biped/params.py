@@ -261,8 +261,10 @@ class InitialConditions(_Validated):
 
     hip_angle_rad: float = INITIAL_HIP_ANGLE_RAD
     speed_mps: float = INITIAL_SPEED_MPS
+    # The CPG phase gamma the first swing starts from (rad; not printed: 0 starts a whole half-cycle).
+    cpg_phase_rad: float = 0.0
 
-    _RANGES = {"hip_angle_rad": (0.0, 0.9), "speed_mps": (-2.0, 3.0)}
+    _RANGES = {"hip_angle_rad": (0.0, 0.9), "speed_mps": (-2.0, 3.0), "cpg_phase_rad": (0.0, math.pi)}
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,8 @@ walks, by the objective:
   window and takes its reward), plus half the largest gain of a single drawn window.
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
-(PAPER_MUTATIONS: the gains the paper does not print, the CPG held at what the start configuration has)
+(PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
+CPG and the printed initiation held at what the start configuration has)
 or "near_paper" (those and the CPG's u_a, u_r, kappa).
 Every generation is appended to `search.jsonl`; a rerun resumes from its last line. The children of a
 generation are scored in parallel on Dask (`executor`).
@@ -79,6 +80,7 @@ PAPER_MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
     ("gait", "ankle_kp"): ("log", 0.1, 1.0, 400.0),
     ("gait", "ankle_kd"): ("log", 0.1, 0.05, 40.0),
     ("gait", "touchdown_min_phase"): ("add", 0.1, 0.3, 3.1),
+    ("initial", "cpg_phase_rad"): ("add", 0.2, 0.0, 3.1),
 }
 # The same, with the CPG's u_a, u_r and kappa free too: for the walker nearest Table III (objective "nearest").
 NEAR_PAPER_MUTATIONS = {
@@ -112,7 +114,7 @@ def policy_draws(count: int = POLICY_DRAWS, seed: int = 0) -> list[tuple[float, 
 def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1, mutations=None) -> EpisodeConfig:
     """A child of `config`: every parameter in `mutations` (default MUTATIONS) moved by a random step
     scaled by sigma / 0.1."""
-    sections = {"cpg": config.cpg.to_dict(), "gait": config.gait.to_dict()}
+    sections = {"cpg": config.cpg.to_dict(), "gait": config.gait.to_dict(), "initial": config.initial.to_dict()}
     for (section, name), (kind, step, lo, hi) in (MUTATIONS if mutations is None else mutations).items():
         value = sections[section][name]
         if kind == "log":
@@ -120,9 +122,8 @@ def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1, mutati
         else:
             value = value + rng.gauss(0.0, step * sigma / 0.1)
         sections[section][name] = min(hi, max(lo, value))
-    return config.replace(
-        cpg=type(config.cpg)(**sections["cpg"]), gait=type(config.gait)(**sections["gait"])
-    )
+    return config.replace(cpg=type(config.cpg)(**sections["cpg"]), gait=type(config.gait)(**sections["gait"]),
+                          initial=type(config.initial)(**sections["initial"]))
 
 
 def _walk(config: EpisodeConfig) -> dict[str, Any]:
@@ -265,11 +266,12 @@ def _coordinates(start: EpisodeConfig, mutations) -> list[tuple[str, str, str, f
 def decode(start: EpisodeConfig, mutations, x, sigma: float = 0.1) -> EpisodeConfig:
     """The configuration at CMA-ES coordinates x (0: the start): a parameter moves by x times its mutation
     step scaled by sigma / 0.1, in log for positive gains, within its bounds."""
-    sections = {"cpg": start.cpg.to_dict(), "gait": start.gait.to_dict()}
+    sections = {"cpg": start.cpg.to_dict(), "gait": start.gait.to_dict(), "initial": start.initial.to_dict()}
     for xi, (section, name, kind, value, step, lo, hi) in zip(x, _coordinates(start, mutations)):
         value = value * math.exp(step * sigma / 0.1 * xi) if kind == "log" else value + step * sigma / 0.1 * xi
         sections[section][name] = min(hi, max(lo, float(value)))
-    return start.replace(cpg=type(start.cpg)(**sections["cpg"]), gait=type(start.gait)(**sections["gait"]))
+    return start.replace(cpg=type(start.cpg)(**sections["cpg"]), gait=type(start.gait)(**sections["gait"]),
+                         initial=type(start.initial)(**sections["initial"]))
 
 
 def _scored(args) -> tuple[float, dict]:
