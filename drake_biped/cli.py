@@ -473,10 +473,10 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--method", choices=["es", "cmaes"], default="es",
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
-    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest"], default="windows",
+    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest", "coast"], default="windows",
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
                              "find a walker), 'policy' (the expected reward of the paper's start policy), "
-                             "'nearest' (the CPG's nearness to Table III)")
+                             "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until touchdown)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

@@ -150,3 +150,19 @@ def test_nearest_objective_prefers_the_walker_nearest_table_iii(monkeypatch):
     assert gait_search.score(EpisodeConfig(cpg=PAPER_CPG), objective="nearest")[0] == 0.0
     assert gait_search.score(near, objective="nearest")[0] == pytest.approx(-math.log(1.1))
     assert gait_search.score(far, objective="nearest")[0] < gait_search.score(near, objective="nearest")[0]
+
+
+def test_coast_objective_scores_windows_that_run_to_touchdown(monkeypatch):
+    seen = []
+
+    def fake_walk(config):
+        seen.append((config.window.start_s, config.window.end_s))
+        walked = not config.window.active or config.window.start_s >= 0.3  # coasting from 0.2 s falls
+        cmt = 0.1 if config.window.active else 0.2
+        return {"walked": walked, "cost_of_transport": cmt, "distance_m": 6.0 if walked else 3.0,
+                "reward": (1.0 if walked else 0.5) / cmt}
+
+    monkeypatch.setattr(gait_search, "_walk", fake_walk)
+    value, _ = gait_search.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="coast")
+    assert seen[1:] == list(gait_search.COAST_WINDOWS) and all(t2 >= 5.0 for _, t2 in seen[1:])
+    assert value == pytest.approx((0.0 + 1.0 + 1.0 + 1.0) / 4 + 0.5 * 1.0)

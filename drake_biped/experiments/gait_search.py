@@ -11,6 +11,8 @@ walks, by the objective:
 - "windows": the largest fractional C_mt saving among the scored windows that also walk (-0.3 if none
   walks), plus 0.03 for every window that walks;
 - "walk": 0 (the search stops improving once a walker is found; use it to find one);
+- "coast": the same score over COAST_WINDOWS, the hip off from t1 = 0.2 ... 0.5 s until the swing foot
+  lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau);
 - "nearest": minus the CPG's distance from Table III (`distance_from_table_iii`), to find the walker whose
   CPG is nearest the paper's (with the "near_paper" mutations);
 - "policy": what the paper's learner climbs from its start: the expected reward of the policy
@@ -90,7 +92,9 @@ NEAR_PAPER_MUTATIONS = {
     **PAPER_MUTATIONS,
 }
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "nearest")
+OBJECTIVES = ("windows", "walk", "policy", "nearest", "coast")
+# Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
+COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 
 
 def distance_from_table_iii(cpg) -> float:
@@ -151,6 +155,8 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         return -distance_from_table_iii(config.cpg), {"baseline": base, "windows": []}
     if objective == "policy":
         windows = policy_draws()
+    elif objective == "coast":
+        windows = COAST_WINDOWS
     rows = []
     for t1, t2 in windows:
         if t2 <= t1:
@@ -159,7 +165,7 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
             row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
         row["window"] = [t1, t2]
         rows.append(row)
-    if objective == "policy":
+    if objective in ("policy", "coast"):
         gains = [r["reward"] / base["reward"] - 1.0 for r in rows]
         value = sum(gains) / len(gains) + 0.5 * max(0.0, max(gains))
         return value, {"baseline": base, "windows": rows}
