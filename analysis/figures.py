@@ -430,9 +430,12 @@ def learner_comparison_figure(curves: dict, record: dict, path: Path) -> Path:
             n = min(len(t) for t in trials)
             runs = np.array([running_cost(t[:n], length) for t in trials])
             ax.plot(np.arange(1, n + 1), np.nanmean(runs, axis=0), color=f"C{k}", label=name)
-    ax.axhline(record["best_window"]["cost_of_transport"], color="k", ls="--", lw=0.8,
-               label=f"best window ({record['best_window']['t1']:g}, {record['best_window']['t2']:g}) s")
-    ax.axhline(record["no_window_cost_of_transport"], color="0.5", ls=":", lw=0.8, label="no window")
+    best = record["best_window"]
+    if best is not None:
+        ax.axhline(best["cost_of_transport"], color="k", ls="--", lw=0.8,
+                   label=f"best window ({best['t1']:g}, {best['t2']:g}) s")
+    if record["no_window_cost_of_transport"]:
+        ax.axhline(record["no_window_cost_of_transport"], color="0.5", ls=":", lw=0.8, label="no window")
     ax.set_xlabel("episode")
     ax.set_ylabel(f"C_mt, running mean of {length} walks (mean over trials)")
     ax.set_title("Learners side by side")

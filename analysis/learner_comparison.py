@@ -50,20 +50,25 @@ def episodes_to_within(episodes: list[dict[str, Any]], target: float, tolerance:
     return int(hits[0]) + 1 if len(hits) else None
 
 
-def compare(record: dict[str, Any], best: dict[str, Any], tolerance: float = 0.05) -> dict[str, Any]:
-    """One learner's row (module docstring) from its learning record and the best window's map row."""
-    target = float(best["cost_of_transport"])
+def compare(record: dict[str, Any], best: dict[str, Any] | None, tolerance: float = 0.05) -> dict[str, Any]:
+    """One learner's row (module docstring) from its learning record and the best window's map row (None
+    when no window of the map walks: then there is no distance and no episode count to report)."""
     ev = record["evaluation"]
     means = np.array([t["final_mean"] for t in record["trials"]], dtype=float)
-    distance = np.linalg.norm(means - np.array([best["t1"], best["t2"]]), axis=1)
-    reach = [episodes_to_within(t["episodes"], target, tolerance) for t in record["trials"]]
+    if best is None:
+        distance = np.full(len(means), math.nan)
+        reach = [None] * len(means)
+    else:
+        target = float(best["cost_of_transport"])
+        distance = np.linalg.norm(means - np.array([best["t1"], best["t2"]]), axis=1)
+        reach = [episodes_to_within(t["episodes"], target, tolerance) for t in record["trials"]]
     return {
         "final_cost_of_transport": ev.get("learned_mean_cost_of_transport"),
         "reduction": ev.get("reduction"),
         "learned_walks": ev.get("learned_walks"),
         "trials": len(record["trials"]),
-        "mean_distance_to_best_s": float(np.mean(distance)),
-        "distance_to_best_s": distance.tolist(),
+        "mean_distance_to_best_s": None if best is None else float(np.mean(distance)),
+        "distance_to_best_s": None if best is None else distance.tolist(),
         "episodes_to_within": reach,
         "reached": sum(r is not None for r in reach),
         "falls": int(sum(e["fell"] for t in record["trials"] for e in t["episodes"])),

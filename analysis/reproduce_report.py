@@ -123,6 +123,10 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     t3 = grid["table_iii"]
     verdicts.append(("Table III walks", "walks (the grid's best)",
                      f"falls after {t3['steps']} steps, {t3['distance_m']:.2f} m", NOT_REPRODUCED))
+    pg = s["paper_gait"]
+    verdicts.append(("Table III walks, ζ driving the swing as printed (unprinted gains searched)", "walks",
+                     ("walks" if not pg["fell"] else f"falls after {pg['steps']} steps") + f", {pg['distance_m']:.2f} m",
+                     REPRODUCED if not pg["fell"] else NOT_REPRODUCED))
     best = grid["best"]
     verdicts.append(("Table IV grid: furthest walk", "Table III, walks",
                      f"{best['distance_m']:.2f} m of {grid['points']} points ({grid['walked']} walk 10 m)", DIFFERS))
@@ -131,6 +135,11 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                      learn_ours, learn_verdict))
     var_ours, var_verdict = reduction_verdict(s["learn_variant"]["evaluation"])
     verdicts.append(("C_mt reduction, exploration matched to the gait", "—", var_ours, f"{BEYOND}; {var_verdict}"))
+    cl = s["compare_learners"]
+    verdicts.append(("Learners side by side: final C_mt (best window)", "—",
+                     ", ".join(f"{name} {_num(r['final_cost_of_transport'])}" for name, r in cl["learners"].items())
+                     + (f" (best window {_num(cl['best_window']['cost_of_transport'])})" if cl["best_window"]
+                        else " (no window walks)"), BEYOND))
     stab_ours, stab_verdict = stability_verdict(s["stability"]["cells"])
     verdicts.append(("Table VI: stable under ±20 N, none vs 0.2–0.5 s", "all stable", stab_ours, stab_verdict))
     m = s["push_margin"]["margins"]
@@ -189,6 +198,17 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"({t3['distance_m']:.2f} m). The default gait walks at u_r 4.62 and κ 2.60, outside Table IV.",
         "",
         "![grid](grid/grid_slices.png)",
+        "",
+    ]
+    lines += [
+        "## Table III as printed (`paper_gait/`)",
+        "",
+        f"The shipped gait `paper`: Table III's CPG ({', '.join(f'{k} {v:g}' for k, v in pg['cpg'].items())}) and the "
+        f"paper's initiation, ζ driving the swing unscaled (the integrated reading), the gains the paper does not "
+        f"print from a search of 1 430 candidates (docs/RESULTS.md): "
+        + ("walks 10 m" if not pg["fell"] else f"falls after {pg['steps']} steps ({pg['fall_reason']}), "
+                                              f"{pg['distance_m']:.2f} m")
+        + ". Record: [result.json](paper_gait/result.json).",
         "",
     ]
     wm = s["window_map"]
@@ -282,6 +302,11 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                 "",
             ]
     lines += [
+        "## Learners side by side (`compare_learners/`, beyond the paper)",
+        "",
+        embed(_read(out, "compare_learners/compare.md"), "compare_learners"),
+        "![learners](compare_learners/compare.png)",
+        "",
         "## Time step (`time_step/`)",
         "",
         embed(_read(out, "time_step/time_step_study.md"), "time_step"),

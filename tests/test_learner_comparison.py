@@ -48,3 +48,10 @@ def test_compare_measures_distance_and_falls():
     assert row["distance_to_best_s"] == pytest.approx([0.3, 0.5])
     assert row["falls"] == 1 and row["episodes"] == 4
     assert row["episodes_to_within"] == [None, 1] and row["reached"] == 1
+
+
+def test_compare_without_a_walking_window_reports_no_distance():
+    record = {"evaluation": {"learned_mean_cost_of_transport": None, "reduction": None, "learned_walks": 0},
+              "trials": [{"final_mean": [0.2, 0.8], "episodes": [_episode(0.2)]}]}
+    row = compare(record, None)
+    assert row["mean_distance_to_best_s"] is None and row["episodes_to_within"] == [None] and row["reached"] == 0

@@ -88,7 +88,8 @@ SMOKE = Profile("smoke", distance_m=5.0, grid_points=1, grid_initiation_points=1
                 margin_tolerance_n=100.0, slope=(1, 1), slope_grid_full=False, time_steps=(0.0005, 0.001),
                 time_step_distance_m=2.0, expected_minutes=1.0)
 
-SECTIONS = ("## The walk", "## Grid search, Table IV", "## Torque-free windows", "## Experiment 1",
+SECTIONS = ("## The walk", "## Grid search, Table IV", "## Table III as printed", "## Torque-free windows",
+            "## Experiment 1", "## Learners side by side",
             "### Table V", "### Exploration matched", "## Pushes and return maps", "Table VI", "### Push margins",
             "## Slopes", "### The slope story, Figs. 8–9", "### Table VII", "### The slope story, Figs. 10–11",
             "## Time step")
@@ -106,11 +107,12 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for heading in SECTIONS:
         assert heading in text, heading
     table = [line for line in text.splitlines() if line.startswith("| ") and "**" in line]
-    assert len(table) == 11
+    assert len(table) == 13
     for row in table:  # every verdict row holds a measured number and a verdict
         ours = row.split(" | ")[2]
         assert re.search(r"\d", ours), row
     for figure in ("report_summary.png", "walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
+                   "compare_learners/compare.png",
                    "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
     html = (tmp_path / "report.html").read_text()

@@ -82,7 +82,10 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
 
     out = Path(out)
     wmap = settings.read_map()
-    best = best_walking_window(wmap)
+    try:
+        best = best_walking_window(wmap)
+    except ValueError:  # no window walks: the learners are still compared with each other and with none
+        best = None
     rows, curves = {}, {}
     with client_or_local(client) as c:
         for name in settings.learners:
@@ -94,7 +97,7 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
         "settings": {"learners": list(settings.learners), "trials": settings.trials, "episodes": settings.episodes,
                      "seed": settings.seed, "mean": list(settings.mean), "variance": settings.variance,
                      "window_map": str(settings.map_path()), "config": settings.config.to_dict()},
-        "best_window": {k: best[k] for k in ("t1", "t2", "cost_of_transport", "cmt_change")},
+        "best_window": None if best is None else {k: best[k] for k in ("t1", "t2", "cost_of_transport", "cmt_change")},
         "no_window_cost_of_transport": wmap["baseline"]["cost_of_transport"],
         "running_length": RUNNING,
         "learners": rows,
@@ -113,9 +116,10 @@ def _cell(value, fmt: str) -> str:
 def markdown(record: dict[str, Any]) -> str:
     best = record["best_window"]
     s = record["settings"]
-    lines = [f"Best walking window of the map: ({best['t1']:g}, {best['t2']:g}) s, C_mt {best['cost_of_transport']:.4f} "
-             f"(no window {record['no_window_cost_of_transport']:.4f}); {s['trials']} trials × {s['episodes']} "
-             f"episodes from ({s['mean'][0]:g}, {s['mean'][1]:g}), variance {s['variance']:g} s².", "",
+    head = ("No window of the map walks" if best is None else
+            f"Best walking window of the map: ({best['t1']:g}, {best['t2']:g}) s, C_mt {best['cost_of_transport']:.4f}")
+    lines = [f"{head} (no window {_cell(record['no_window_cost_of_transport'], '.4f')}); {s['trials']} trials × "
+             f"{s['episodes']} episodes from ({s['mean'][0]:g}, {s['mean'][1]:g}), variance {s['variance']:g} s².", "",
              "| learner | final C_mt | reduction | final means that walk | distance to best (s) | "
              "trials within 5 % (episode) | falls | wall (min) |",
              "|---|---:|---:|---:|---:|---|---:|---:|"]
@@ -123,7 +127,7 @@ def markdown(record: dict[str, Any]) -> str:
         reach = ", ".join("—" if e is None else str(e) for e in r["episodes_to_within"])
         lines.append(f"| {name} | {_cell(r['final_cost_of_transport'], '.4f')} | "
                      f"{_cell(None if r['reduction'] is None else 100 * r['reduction'], '+.1f')} % | "
-                     f"{r['learned_walks']}/{r['trials']} | {r['mean_distance_to_best_s']:.3f} | "
+                     f"{r['learned_walks']}/{r['trials']} | {_cell(r['mean_distance_to_best_s'], '.3f')} | "
                      f"{r['reached']}/{r['trials']} ({reach}) | {r['falls']}/{r['episodes']} | {r['wall_s'] / 60:.1f} |")
     return "\n".join(lines) + "\n"
 

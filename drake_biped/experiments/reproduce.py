@@ -6,9 +6,11 @@ functions as its own command:
     walk/            the default gait, 10 m: record, figures, Meshcat HTML and GIF
     time_step/       the time-step study
     grid/            Table IV's grid (CPG ranges and the initiation), level ground; and Table III itself
+    paper_gait/      the shipped gait `paper`: Table III driving the swing as printed (integrated reading)
     window_map/      the default gait's torque-free windows against none
     learn/           Experiment 1 with the paper's settings (Table V, Figs. 4-6)
     learn_variant/   the same with exploration matched to the gait (start 0.4, 0.4; variance 0.01)
+    compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
     stability/       pushes and return maps, none vs 0.2-0.5 s (Table VI, Fig. 7)
     push_margin/     the largest pushes survived, none vs 0.2-0.5 s
     slope_default/   the default gait at the foot of 0.02 rad
@@ -66,6 +68,7 @@ class Profile:
     time_steps: tuple[float, ...]
     time_step_distance_m: float
     expected_minutes: float  # on 2 cores
+    compare: tuple[int, int] = (1, 6)  # trials, episodes per learner in the side-by-side comparison
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -74,7 +77,7 @@ class Profile:
 QUICK = Profile("quick", 10.0, 2, 1, (2, 6), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 6.0)
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
-               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 150.0)
+               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 330.0, compare=(5, 300))
 
 
 class Reproduction:
@@ -129,6 +132,35 @@ class Reproduction:
                     "real_time_factor": r.real_time_factor}
 
         return self.experiment("walk", {"distance_m": self.profile.distance_m}, run)
+
+    def paper_gait(self) -> dict:
+        from drake_biped.experiments import walk
+
+        config = load_gait("paper")
+        config = config.replace(sim=dataclasses.replace(config.sim, distance_m=self.profile.distance_m))
+
+        def run(folder: Path) -> dict:
+            r = walk.run(walk.WalkSettings(config, animation=False), folder, progress=False)
+            return {"distance_m": r.distance_m, "fell": r.fell, "fall_reason": r.fall_reason, "steps": len(r.steps),
+                    "cost_of_transport": r.cost_of_transport, "cpg": config.cpg.to_dict(),
+                    "initial": config.initial.to_dict()}
+
+        return self.experiment("paper_gait", {"config": config.to_dict()}, run)
+
+    def compare_learners(self) -> dict:
+        from drake_biped.experiments import compare_learners
+
+        trials, episodes = self.profile.compare
+        settings = compare_learners.CompareSettings(self.level, str(self.out / "window_map"), trials=trials,
+                                                    episodes=episodes)
+
+        def run(folder: Path) -> dict:
+            record = compare_learners.run(settings, folder, self._client, progress=False)
+            return {k: record[k] for k in ("best_window", "no_window_cost_of_transport", "learners")}
+
+        return self.experiment("compare_learners", {"learners": list(settings.learners), "trials": trials,
+                                                    "episodes": episodes, "distance_m": self.profile.distance_m},
+                               run)
 
     def time_step(self) -> dict:
         from drake_biped.experiments import time_step
@@ -299,8 +331,8 @@ class Reproduction:
     def slope2deg(self) -> dict:
         return self._slope("slope2deg", "climbing_2deg", SLOPE_2DEG_RAD_PRINTED)
 
-    STEPS = ("walk", "time_step", "grid", "window_map", "learn", "learn_variant", "stability", "push_margin",
-             "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
+    STEPS = ("walk", "time_step", "grid", "paper_gait", "window_map", "learn", "learn_variant", "compare_learners",
+             "stability", "push_margin", "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
 
     def run_all(self) -> dict[str, dict]:
         self.out.mkdir(parents=True, exist_ok=True)
