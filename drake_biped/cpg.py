@@ -46,16 +46,9 @@ def swing_reference(gamma: float, liftoff_angle: float, target_angle: float) -> 
     return liftoff_angle + (target_angle - liftoff_angle) * 0.5 * (1.0 - math.cos(gamma))
 
 
-# Control updates fall on a grid of context times, and t - T_n computed from two of them carries rounding
-# noise (0.2 may arrive as 0.19999999999999996): window bounds are compared with this tolerance so that a
-# bound on the grid is met exactly at its update.
+# Times since T_n carry rounding noise (0.2 may arrive as 0.19999999999999996): window bounds are compared
+# with this tolerance, so that a bound that falls on an update is met exactly there.
 WINDOW_TOLERANCE_S = 1e-9
-
-
-def in_torque_free_window(time_in_step_s: float, start_s: float, end_s: float) -> bool:
-    """True while the hip motor is off: start_s <= time since T_n < end_s (to WINDOW_TOLERANCE_S),
-    and end_s > start_s."""
-    return end_s > start_s and start_s - WINDOW_TOLERANCE_S <= time_in_step_s < end_s - WINDOW_TOLERANCE_S
 
 
 def torque_free_fraction(elapsed_s: float, period_s: float, start_s: float, end_s: float) -> float:

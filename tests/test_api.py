@@ -105,9 +105,18 @@ def test_the_paper_gait_holds_table_iii_and_the_paper_initiation_as_printed():
 def test_learners_from_the_top_level_api():
     import drake_biped as db
 
+    # After one episode neither moves: GARB's first baseline is that reward (r - B = 0), and CMA-ES updates
+    # only once its whole generation is told. A second, better GARB episode moves the mean along the
+    # eligibility trace by Table II's first rate: 0.1 * (r - B) * (e2 + 0.8 e1).
     for name in ("garb", "cmaes"):
         learner = db.make_learner(name, mean=(0.5, 0.5), variance=0.04, seed=0)
         t = learner.ask()
-        assert t.shape == (2,)
+        assert t.shape == (2,) and not np.allclose(t, (0.5, 0.5))
         learner.tell(t, 4.0)
-        assert learner.mean.shape == (2,)
+        np.testing.assert_array_equal(learner.mean, (0.5, 0.5))
+    garb = db.make_learner("garb", seed=0)
+    t1 = garb.ask()
+    garb.tell(t1, 4.0)
+    t2 = garb.ask()
+    garb.tell(t2, 6.0)  # baseline (4 + 6) / 2 = 5
+    np.testing.assert_allclose(garb.mean, 0.5 + 0.1 * (6.0 - 5.0) * ((t2 - 0.5) + 0.8 * (t1 - 0.5)), rtol=1e-12)

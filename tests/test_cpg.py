@@ -37,7 +37,8 @@ def test_swing_reference_endpoints_and_slope():
     (0.851 - 0.651, 0.2, 0.5, True), (0.577 - 0.077, 0.2, 0.5, False),
 ])
 def test_window_membership(t, start, end, inside):
-    assert cpg.in_torque_free_window(t, start, end) is inside
+    """A control period of 1 ms starting at t is wholly inside the window or wholly outside it."""
+    assert cpg.torque_free_fraction(t, 1e-3, start, end) == (1.0 if inside else 0.0)
 
 
 @pytest.mark.parametrize("elapsed, fraction", [

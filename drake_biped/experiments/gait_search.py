@@ -118,16 +118,15 @@ def policy_draws(count: int = POLICY_DRAWS, seed: int = 0) -> list[tuple[float, 
 def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1, mutations=None) -> EpisodeConfig:
     """A child of `config`: every parameter in `mutations` (default MUTATIONS) moved by a random step
     scaled by sigma / 0.1."""
-    sections = {"cpg": config.cpg.to_dict(), "gait": config.gait.to_dict(), "initial": config.initial.to_dict()}
+    values = {}
     for (section, name), (kind, step, lo, hi) in (MUTATIONS if mutations is None else mutations).items():
-        value = sections[section][name]
+        value = getattr(getattr(config, section), name)
         if kind == "log":
             value = value * math.exp(rng.gauss(0.0, step * sigma / 0.1))
         else:
             value = value + rng.gauss(0.0, step * sigma / 0.1)
-        sections[section][name] = min(hi, max(lo, value))
-    return config.replace(cpg=type(config.cpg)(**sections["cpg"]), gait=type(config.gait)(**sections["gait"]),
-                          initial=type(config.initial)(**sections["initial"]))
+        values[f"{section}.{name}"] = min(hi, max(lo, value))
+    return config.override(values)
 
 
 def _walk(config: EpisodeConfig) -> dict[str, Any]:
@@ -207,6 +206,44 @@ class GaitSearchSettings:
             )
 
 
+def _search_start(settings: GaitSearchSettings) -> EpisodeConfig:
+    """The start configuration, walking the search's distance (with time enough for it)."""
+    sim = settings.config.sim
+    return settings.config.replace(sim=dataclasses.replace(
+        sim, distance_m=settings.distance_m, max_time_s=max(sim.max_time_s, 6.0 * settings.distance_m)))
+
+
+def _score_start(c, settings: GaitSearchSettings, start: EpisodeConfig, windows, log: Path, **extra) -> float:
+    """Generation 0: score the start on the cluster and log it with the search's settings; its score."""
+    value, detail = c.submit(score, start, windows, settings.objective, pure=False).result()
+    _append(log, {"generation": 0, "parent": start.to_dict(), "parent_score": value, "detail": detail,
+                  "seed": settings.seed, "sigma": settings.sigma, "mutations": settings.mutations,
+                  "objective": settings.objective, **extra, "versions": versions()})
+    return value
+
+
+def _generations(settings: GaitSearchSettings, first: int, desc: str, progress: bool):
+    """The generations still to run, counted on a progress bar when asked: yields (generation, note), note(text)
+    showing text beside the bar."""
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=settings.generations, initial=min(first - 1, settings.generations), desc=desc, unit="gen")
+
+    def note(text: str) -> None:
+        if bar is not None:
+            bar.update(1)
+            bar.set_postfix_str(text)
+
+    try:
+        for gen in range(first, settings.generations + 1):
+            yield gen, note
+    finally:
+        if bar is not None:
+            bar.close()
+
+
 def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """Evolve from settings.config on `client` (a LocalCluster when None); write `search.jsonl` (one line
     per generation) and `best_config.json` (use it with --params); return the best and its score."""
@@ -215,45 +252,26 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     log = out / "search.jsonl"
-    start, seed, sigma = settings.config, settings.seed, settings.sigma
-    start = start.replace(sim=dataclasses.replace(start.sim, distance_m=settings.distance_m,
-                                                  max_time_s=max(start.sim.max_time_s, 6.0 * settings.distance_m)))
+    start, seed, sigma = _search_start(settings), settings.seed, settings.sigma
     windows = [tuple(w) for w in settings.windows]
-    first = 1
     records = _read_log(log)
-    bar = None
     with client_or_local(client) as c:
         if records:
             last = records[-1]
             parent, parent_score, first = last["parent"], last["parent_score"], last["generation"] + 1
         else:
-            parent = start.to_dict()
-            parent_score, detail = c.submit(score, start, windows, settings.objective, pure=False).result()
-            _append(log, {"generation": 0, "parent": parent, "parent_score": parent_score, "detail": detail,
-                          "seed": seed, "sigma": sigma, "mutations": settings.mutations,
-                          "objective": settings.objective, "versions": versions()})
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=settings.generations, initial=min(first - 1, settings.generations), desc="search",
-                       unit="gen")
-        try:
-            for gen in range(first, settings.generations + 1):
-                jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows, settings.mutations,
-                         settings.objective) for k in range(settings.offspring)]
-                children = map_ordered(c, _child, jobs)
-                best_dict, best_score, best_detail = max(children, key=lambda ch: ch[1])
-                if best_score >= parent_score:
-                    parent, parent_score = best_dict, best_score
-                _append(log, {"generation": gen, "parent": parent, "parent_score": parent_score,
-                              "best_child_score": best_score, "child_scores": [ch[1] for ch in children],
-                              "best_child_detail": best_detail})
-                if bar is not None:
-                    bar.update(1)
-                    bar.set_postfix_str(f"score {parent_score:+.3f}")
-        finally:
-            if bar is not None:
-                bar.close()
+            parent, parent_score, first = start.to_dict(), _score_start(c, settings, start, windows, log), 1
+        for gen, note in _generations(settings, first, "search", progress):
+            jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows, settings.mutations,
+                     settings.objective) for k in range(settings.offspring)]
+            children = map_ordered(c, _child, jobs)
+            best_dict, best_score, best_detail = max(children, key=lambda ch: ch[1])
+            if best_score >= parent_score:
+                parent, parent_score = best_dict, best_score
+            _append(log, {"generation": gen, "parent": parent, "parent_score": parent_score,
+                          "best_child_score": best_score, "child_scores": [ch[1] for ch in children],
+                          "best_child_detail": best_detail})
+            note(f"score {parent_score:+.3f}")
     write_text_atomic(out / "best_config.json", json.dumps(parent, indent=2) + "\n")
     return {"parent": parent, "score": parent_score}
 
@@ -272,12 +290,11 @@ def _coordinates(start: EpisodeConfig, mutations) -> list[tuple[str, str, str, f
 def decode(start: EpisodeConfig, mutations, x, sigma: float = 0.1) -> EpisodeConfig:
     """The configuration at CMA-ES coordinates x (0: the start): a parameter moves by x times its mutation
     step scaled by sigma / 0.1, in log for positive gains, within its bounds."""
-    sections = {"cpg": start.cpg.to_dict(), "gait": start.gait.to_dict(), "initial": start.initial.to_dict()}
+    values = {}
     for xi, (section, name, kind, value, step, lo, hi) in zip(x, _coordinates(start, mutations)):
         value = value * math.exp(step * sigma / 0.1 * xi) if kind == "log" else value + step * sigma / 0.1 * xi
-        sections[section][name] = min(hi, max(lo, float(value)))
-    return start.replace(cpg=type(start.cpg)(**sections["cpg"]), gait=type(start.gait)(**sections["gait"]),
-                         initial=type(start.initial)(**sections["initial"]))
+        values[f"{section}.{name}"] = min(hi, max(lo, float(value)))
+    return start.override(values)
 
 
 def _scored(args) -> tuple[float, dict]:
@@ -300,9 +317,7 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
     out.mkdir(parents=True, exist_ok=True)
     log = out / "search.jsonl"
     mutations = MUTATION_SETS[settings.mutations]
-    start = settings.config.replace(sim=dataclasses.replace(
-        settings.config.sim, distance_m=settings.distance_m,
-        max_time_s=max(settings.config.sim.max_time_s, 6.0 * settings.distance_m)))
+    start = _search_start(settings)
     windows = [tuple(w) for w in settings.windows]
     es = cma.CMAEvolutionStrategy(np.zeros(len(mutations)), 1.0, {
         "popsize": max(4, settings.offspring), "seed": settings.seed + 1, "verbose": -9, "bounds": [-6.0, 6.0]})
@@ -314,41 +329,25 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
     records = _read_log(log)
     for r in records[1:]:
         es.tell(ask(r["generation"]), [-v for v in r["child_scores"]])
-    if records:
-        best, best_score, first = records[-1]["parent"], records[-1]["parent_score"], records[-1]["generation"] + 1
-    bar = None
     with client_or_local(client) as c:
-        if not records:  # generation 0: the start itself, the best so far until a candidate beats it
-            best = start.to_dict()
-            best_score, detail = c.submit(score, start, windows, settings.objective, pure=False).result()
-            first = 1
-            _append(log, {"generation": 0, "parent": best, "parent_score": best_score, "detail": detail,
-                          "seed": settings.seed, "sigma": settings.sigma, "mutations": settings.mutations,
-                          "objective": settings.objective, "method": "cmaes", "versions": versions()})
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=settings.generations, initial=min(first - 1, settings.generations), desc="cma-es",
-                       unit="gen")
-        try:
-            for gen in range(first, settings.generations + 1):
-                xs = ask(gen)
-                configs = [decode(start, mutations, x, settings.sigma).to_dict() for x in xs]
-                results = map_ordered(c, _scored, [(cfg, windows, settings.objective) for cfg in configs])
-                scores = [r[0] for r in results]
-                es.tell(xs, [-v for v in scores])
-                k = int(np.argmax(scores))
-                if scores[k] > best_score:
-                    best, best_score = configs[k], scores[k]
-                _append(log, {"generation": gen, "parent": best, "parent_score": best_score,
-                              "best_child_score": scores[k], "child_scores": scores, "best_child_detail": results[k][1],
-                              "mean": [float(v) for v in es.mean], "step": float(es.sigma)})
-                if bar is not None:
-                    bar.update(1)
-                    bar.set_postfix_str(f"best {best_score:+.3f}")
-        finally:
-            if bar is not None:
-                bar.close()
+        if records:
+            best, best_score, first = records[-1]["parent"], records[-1]["parent_score"], records[-1]["generation"] + 1
+        else:  # generation 0: the start itself, the best so far until a candidate beats it
+            best, first = start.to_dict(), 1
+            best_score = _score_start(c, settings, start, windows, log, method="cmaes")
+        for gen, note in _generations(settings, first, "cma-es", progress):
+            xs = ask(gen)
+            configs = [decode(start, mutations, x, settings.sigma).to_dict() for x in xs]
+            results = map_ordered(c, _scored, [(cfg, windows, settings.objective) for cfg in configs])
+            scores = [r[0] for r in results]
+            es.tell(xs, [-v for v in scores])
+            k = int(np.argmax(scores))
+            if scores[k] > best_score:
+                best, best_score = configs[k], scores[k]
+            _append(log, {"generation": gen, "parent": best, "parent_score": best_score,
+                          "best_child_score": scores[k], "child_scores": scores, "best_child_detail": results[k][1],
+                          "mean": [float(v) for v in es.mean], "step": float(es.sigma)})
+            note(f"best {best_score:+.3f}")
     write_text_atomic(out / "best_config.json", json.dumps(best, indent=2) + "\n")
     return {"parent": best, "score": best_score}
 
