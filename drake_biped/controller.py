@@ -25,7 +25,9 @@ swing foot's clearance crossed the touchdown height, interpolated between two up
 CPG phase and the torque-free window all count from T_n; the section angle is interpolated to T_n and the
 section rate extrapolated to T_n from the two updates before it (before the impact, which a 1 ms update
 would otherwise sample at a random depth); and a control period that a window edge cuts applies the
-servo's torque scaled by the part of the period outside the window. tests/test_hot_path.py pins this down.
+servo's torque scaled by the part of the period outside the window; and a switch of the swing knee's
+bang-bang torque that falls inside a period (its condition crossed along the state extrapolated over the
+period) blends the two torques by the part of the period each holds. tests/test_hot_path.py and tests/test_gait.py pin this down.
 """
 
 from __future__ import annotations
@@ -342,7 +344,11 @@ class CpgWalkingController(LeafSystem):
         a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
         s[a_sw] = tau_swing_hip
         s[a_st] = tau_stance_hip
-        s[a_sw + KNEE] = gait.clip(gait.swing_knee_torque(g, gamma, q[sw_i + KNEE], swing.thigh_angle), _KNEE_LIMIT)
+        # the swing knee's switches placed inside the period, along the state extrapolated over it
+        knee_start = (gamma, q[sw_i + KNEE], swing.thigh_angle)
+        knee_end = (cpg.advance_phase(self._cpg, gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
+                    swing.thigh_angle + dt * swing_rate)
+        s[a_sw + KNEE] = gait.clip(gait.swing_knee_torque_over(g, knee_start, knee_end), _KNEE_LIMIT)
         s[a_st + KNEE] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
         for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
             foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]

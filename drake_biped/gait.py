@@ -53,6 +53,30 @@ def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float, thigh_a
     return 0.0
 
 
+def swing_knee_torque_over(gait: GaitParams, start: tuple[float, float, float], end: tuple[float, float, float],
+                           iterations: int = 20) -> float:
+    """The swing knee's torque over a control period along which (phase, knee angle, thigh angle) move
+    linearly from `start` to `end`: the bang-bang torque at the start, or, where a switch falls inside the
+    period, the two branches blended by the part of the period each holds (the switch's place found by
+    bisection), so that a switch acts at its own time rather than at the next update and the torque's
+    impulse is continuous in the state. One switch per period is resolved (a control period is far
+    shorter than a branch)."""
+    first = swing_knee_torque(gait, *start)
+    last = swing_knee_torque(gait, *end)
+    if first == last:
+        return first
+    lo, hi = 0.0, 1.0  # the branch at lo is the first one, at hi it is not
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        point = [a + mid * (b - a) for a, b in zip(start, end)]
+        if swing_knee_torque(gait, *point) == first:
+            lo = mid
+        else:
+            hi = mid
+    f = 0.5 * (lo + hi)
+    return f * first + (1.0 - f) * last
+
+
 def ankle_torque(gait: GaitParams, foot_angle: float, foot_rate: float, ground_angle: float) -> float:
     """PD that keeps the foot parallel to the local ground."""
     return -gait.ankle_kp * (foot_angle - ground_angle) - gait.ankle_kd * foot_rate

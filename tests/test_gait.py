@@ -28,6 +28,19 @@ def test_swing_knee_passive_middle():
     assert gait.swing_knee_torque(g, 2.6, 0.8, 0.3) == -7.0  # extension
 
 
+def test_swing_knee_switch_inside_a_period_blends_by_the_time_each_branch_holds():
+    g = GaitParams(knee_flex_torque=5.0, knee_extend_torque=7.0, knee_extend_phase=2.5, knee_flex_max_rad=1.2,
+                   knee_extend_thigh_rad=0.2, knee_flex_until_phase=1.0)
+    # the phase crosses knee_flex_until_phase a quarter of the way through: flex for 1/4, passive for 3/4
+    assert gait.swing_knee_torque_over(g, (0.9, 0.5, -0.2), (1.3, 0.5, -0.2)) == pytest.approx(1.25, abs=1e-5)
+    # the thigh reaches knee_extend_thigh_rad at 60 % of the period (phase already past 2.5): passive, then extend
+    assert gait.swing_knee_torque_over(g, (2.6, 0.5, 0.14), (2.6, 0.5, 0.24)) == pytest.approx(-7.0 * 0.4, abs=1e-5)
+    # no switch: the branch's torque exactly; and the blend is continuous as the crossing leaves the period
+    assert gait.swing_knee_torque_over(g, (1.5, 0.5, 0.0), (1.6, 0.5, 0.0)) == 0.0
+    assert gait.swing_knee_torque_over(g, (0.5, 0.5, 0.0), (1.0 - 1e-9, 0.5, 0.0)) == 5.0
+    assert gait.swing_knee_torque_over(g, (0.5, 0.5, 0.0), (1.0 + 1e-9, 0.5, 0.0)) == pytest.approx(5.0, abs=1e-5)
+
+
 def test_touchdown_needs_every_condition():
     ok = dict(time_in_step_s=0.5, swing_clearance_m=0.001, swing_ankle_advance_m=0.2, gamma=2.0)
     g = GaitParams(touchdown_min_step_s=0.15, touchdown_height_m=0.002, touchdown_min_advance_m=0.05,
