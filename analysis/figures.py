@@ -444,3 +444,39 @@ def learner_comparison_figure(curves: dict, record: dict, path: Path) -> Path:
     save_figure(fig, Path(path), dpi=110)
     plt.close(fig)
     return Path(path)
+
+
+def floquet_figure(record: dict, path) -> None:
+    """The multipliers in the unit circle (trivial ones hollow) and the sweep's spectral radius against ε."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(9.5, 4.2))
+    angle = np.linspace(0, 2 * np.pi, 200)
+    ax.plot(np.cos(angle), np.sin(angle), "k-", lw=0.8)
+    mult = np.array(record["multipliers"])
+    trivial = np.array([t is not None for t in record["trivial"]])
+    ax.plot(mult[~trivial, 0], mult[~trivial, 1], "o", color="C0", label="multipliers")
+    if trivial.any():
+        ax.plot(mult[trivial, 0], mult[trivial, 1], "o", mfc="none", color="C3", label="trivial (section)")
+    lim = max(1.1, 1.1 * float(np.max(np.abs(mult[:, 0] + 1j * mult[:, 1]))))
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_aspect("equal")
+    ax.axhline(0, color="0.8", lw=0.6)
+    ax.axvline(0, color="0.8", lw=0.6)
+    ax.set_xlabel("Re λ")
+    ax.set_ylabel("Im λ")
+    ax.set_title(f"Floquet multipliers, spectral radius {record['spectral_radius']:.3f}", fontsize=10)
+    ax.legend(fontsize=8, loc="lower left")
+    rows = [r for r in record["epsilon_sweep"] if r["spectral_radius"] is not None]
+    bx.semilogx([r["epsilon"] for r in rows], [r["spectral_radius"] for r in rows], "o-")
+    if record.get("converged_epsilon"):
+        lo, hi = record["plateau"]["plateau"]
+        bx.axvspan(lo, hi, color="C2", alpha=0.15, label="converged (≤ 5 % change)")
+        bx.axvline(record["converged_epsilon"], color="C2", lw=1, label=f"chosen ε {record['converged_epsilon']:.0e}")
+        bx.legend(fontsize=8)
+    bx.axhline(1.0, color="k", lw=0.6, ls=":")
+    bx.set_xlabel("perturbation ε (each coordinate, its SI unit)")
+    bx.set_ylabel("spectral radius of the difference Jacobian")
+    bx.set_title("Where the central differences converge", fontsize=10)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
+    plt.close(fig)

@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.floquet import check_outputs, difference_jacobian, serial
+
 
 @dataclass(frozen=True)
 class ReturnMapFit:
@@ -182,25 +184,9 @@ def step_jacobian(
     h = np.broadcast_to(np.asarray(deltas, dtype=float), (dim,)).copy()
     if np.any(~np.isfinite(h)) or np.any(h <= 0):
         raise ValueError(f"deltas must be positive, got {deltas!r}")
-
-    def call(x: np.ndarray) -> np.ndarray:
-        y = step(x)
-        if y is None:
-            raise RuntimeError(f"the step from section state {x.tolist()} failed (a fall): use smaller deltas")
-        y = np.asarray(y, dtype=float).reshape(-1)
-        if y.shape != (dim,) or not np.all(np.isfinite(y)):
-            raise RuntimeError(f"the step from {x.tolist()} returned {y.tolist()}, not {dim} finite numbers")
-        return y
-
-    base = call(x0)
-    jac = np.empty((dim, dim))
-    for j in range(dim):
-        e = np.zeros(dim)
-        e[j] = h[j]
-        if central:
-            jac[:, j] = (call(x0 + e) - call(x0 - e)) / (2 * h[j])
-        else:
-            jac[:, j] = (call(x0 + e) - base) / h[j]
+    evaluate = serial(step)
+    (base,) = check_outputs(evaluate([x0]), [x0], dim)  # a failed step raises StepFailed, a RuntimeError
+    jac = difference_jacobian(evaluate, x0, h, central=central, base=base)
     eig = np.linalg.eigvals(jac)
     return {
         "jacobian": jac,

@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | compare-learners | figures | landscape | stability | push-margin | grid | slope | reproduce`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | compare-learners | figures | landscape | stability | floquet | push-margin | grid | slope | reproduce`.
 
 Parsing only: each command turns its options into its experiment's settings and calls the experiment's
 `run(settings, out, client)` (drake_biped.experiments), which writes every file. Every numeric option is
@@ -288,6 +288,24 @@ def cmd_stability(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_floquet(args: argparse.Namespace) -> int:
+    from drake_biped.experiments import floquet
+    from drake_biped.params import TorqueFreeWindow
+
+    config = _episode_config(args)
+    if args.policy is not None or args.t1 is not None or args.t2 is not None:
+        config = config.replace(window=TorqueFreeWindow(*_chosen_window(args)))
+    settings = floquet.FloquetSettings(config, settle_steps=args.settle_steps,
+                                       **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}))
+    out = Path(args.out)
+    with _client(args) as client:
+        record = floquet.run(settings, out, client)
+    print(f"spectral radius {record['spectral_radius']:.4f}, fixed-point residual "
+          f"{record['fixed_point_residual']:.1e}, converged epsilon {record['converged_epsilon']}")
+    print(f"wrote {out}/floquet.json, floquet.md, floquet.png")
+    return 0
+
+
 def cmd_push_margin(args: argparse.Namespace) -> int:
     from drake_biped.experiments import push_margin
 
@@ -376,6 +394,16 @@ def _learner_names(text: str) -> list[str]:
         raise argparse.ArgumentTypeError(f"{text!r}: a comma-separated list of distinct learners from "
                                          f"{sorted(LEARNERS)}")
     return names
+
+
+def _positive_list(text: str) -> list[float]:
+    try:
+        values = [float(t) for t in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) < 3 or not all(math.isfinite(v) and v > 0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: at least three positive numbers, comma-separated")
+    return values
 
 
 def _add_window_options(p: argparse.ArgumentParser) -> None:
@@ -547,6 +575,20 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_options(pm)
     pm.add_argument("--out", required=True, type=_out_folder, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
+
+    fl = sub.add_parser("floquet", help="the gait's periodic orbit (Newton on the full-state step map) and its "
+                        "Floquet multipliers by central differences through Drake, on Dask")
+    _add_episode_options(fl)
+    fl.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default: the gait's window")
+    fl.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default: the gait's window")
+    fl.add_argument("--policy", default=None, help="a learning.json: analyse its best learned torque-free period")
+    fl.add_argument("--settle-steps", type=_count, default=8,
+                    help="touchdowns walked from the initiation before the search starts (default 8)")
+    fl.add_argument("--epsilons", type=_positive_list, default=None,
+                    help="perturbation sizes of the sweep, comma-separated (default 1e-8 to 3e-3, half decades)")
+    _add_cluster_options(fl)
+    fl.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    fl.set_defaults(func=cmd_floquet)
 
     grid = sub.add_parser("grid", help="grid search of CPG parameters and the initiation (Table IV), on Dask")
     _add_episode_options(grid)

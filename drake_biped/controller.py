@@ -187,6 +187,11 @@ class CpgWalkingController(LeafSystem):
     def state_group(self) -> int:
         return int(self._state_group)
 
+    @property
+    def torque_group(self) -> int:
+        """The discrete group of the held torques (the "actuation" output)."""
+        return int(self._torque_group)
+
     def set_initial_state(
         self,
         context,

@@ -174,6 +174,28 @@ class Kick:
             raise ValueError(f"Kick.time_s must be > 0, got {self.time_s!r}")
 
 
+def reset_context(parts: BipedDiagram, simulator: Simulator, config: EpisodeConfig):
+    """Put the simulator's context at the start of an episode of `config`: defaults, time 0, empty logs,
+    the controller configured, the paper's initiation. Returns the plant's and the controller's contexts
+    and the initial centre-of-mass x."""
+    root = simulator.get_mutable_context()
+    parts.diagram.SetDefaultContext(root)
+    root.SetTime(0.0)
+    for log in (parts.state_log, parts.controller_log, parts.actuation_log):
+        if log is not None:
+            log.FindMutableLog(root).Clear()
+    parts.controller.configure(config)
+    plant_ctx = parts.plant.GetMyMutableContextFromRoot(root)
+    q0, v0, stance_right, liftoff = initial_state(config)
+    parts.plant.SetPositions(plant_ctx, q0)
+    parts.plant.SetVelocities(plant_ctx, v0)
+    com_x0 = center_of_mass(q0, parts.masses)[0]
+    ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
+    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
+                                      pitch=q0[2], phase=config.initial.cpg_phase_rad)
+    return plant_ctx, ctrl_ctx, com_x0
+
+
 def simulate(
     config: EpisodeConfig,
     meshcat=None,
@@ -197,21 +219,7 @@ def simulate(
     else:
         parts = build_diagram(config, meshcat=meshcat, record=record, log_period_s=log_period_s)
         simulator = Simulator(parts.diagram)
-    root = simulator.get_mutable_context()
-    parts.diagram.SetDefaultContext(root)
-    root.SetTime(0.0)
-    for log in (parts.state_log, parts.controller_log, parts.actuation_log):
-        if log is not None:
-            log.FindMutableLog(root).Clear()
-    parts.controller.configure(config)
-    plant_ctx = parts.plant.GetMyMutableContextFromRoot(root)
-    q0, v0, stance_right, liftoff = initial_state(config)
-    parts.plant.SetPositions(plant_ctx, q0)
-    parts.plant.SetVelocities(plant_ctx, v0)
-    com_x0 = center_of_mass(q0, parts.masses)[0]
-    ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
-    parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
-                                      pitch=q0[2], phase=config.initial.cpg_phase_rad)
+    plant_ctx, ctrl_ctx, com_x0 = reset_context(parts, simulator, config)
     group = parts.controller.state_group
     if progress is not None:
         next_report = [0.0]

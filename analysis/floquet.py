@@ -1,0 +1,237 @@
+"""The algebra of a periodic orbit's stability: the fixed point of a step map by Newton's method, its
+Jacobian by central differences, a sweep of the perturbation that shows where the Jacobian has converged,
+the multipliers (Floquet multipliers of the orbit) and their eigenvectors, and the decay of a perturbation
+the linearisation predicts. Plain numpy and scipy, on any map given as a function; nothing here knows about
+Drake (analysis/step_map.py is the biped's map through the simulator).
+
+The maps are evaluated in batches: `evaluate(points) -> outputs` takes a list of states and returns the
+next states (None for a step that failed: a fall), so that a caller can run a Jacobian's 2n steps in
+parallel. `serial(step)` turns a one-state function into such a batch function.
+
+On a Poincaré section of an autonomous system one multiplier is trivial: a perturbation along the flow only
+moves the crossing in time, and the map sends it back onto the section. In section coordinates that keep
+every state variable (the section's constraint g(x) = 0 not eliminated), that multiplier is exactly 0 and
+its left eigenvector is the section's normal ∇g (g(P(x)) = 0 for every x, so ∇g·DP = 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+Batch = Callable[[Sequence[np.ndarray]], Sequence[np.ndarray | None]]
+
+
+class StepFailed(RuntimeError):
+    """A step of the map failed (the walker fell, or the state left where the map is defined)."""
+
+
+def serial(step: Callable[[np.ndarray], np.ndarray | None]) -> Batch:
+    """A batch evaluator that calls `step` on each state in turn."""
+    return lambda points: [step(np.asarray(p, dtype=float)) for p in points]
+
+
+def check_outputs(outputs: Sequence[np.ndarray | None], points: Sequence[np.ndarray], dim: int) -> list[np.ndarray]:
+    out = []
+    for x, y in zip(points, outputs):
+        if y is None:
+            raise StepFailed(f"the step from state {np.asarray(x).tolist()} failed (a fall): use a smaller "
+                             "perturbation")
+        y = np.asarray(y, dtype=float).reshape(-1)
+        if y.shape != (dim,) or not np.all(np.isfinite(y)):
+            raise StepFailed(f"the step from {np.asarray(x).tolist()} returned {y.tolist()}, not {dim} finite "
+                             "numbers")
+        out.append(y)
+    return out
+
+
+def difference_jacobian(evaluate: Batch, x: np.ndarray, epsilon: float | Sequence[float],
+                        central: bool = True, base: np.ndarray | None = None) -> np.ndarray:
+    """The Jacobian of the map at `x` by finite differences, one batch of 2n (central) or n + 1 (forward,
+    or n when `base` = the map at x is given) evaluations. `epsilon`: the perturbation of each coordinate
+    (one number for all, or one per coordinate), in the coordinates' own units."""
+    x = np.asarray(x, dtype=float).reshape(-1)
+    dim = len(x)
+    h = np.broadcast_to(np.asarray(epsilon, dtype=float), (dim,)).copy()
+    if np.any(~np.isfinite(h)) or np.any(h <= 0):
+        raise ValueError(f"epsilon must be positive, got {epsilon!r}")
+    steps = np.diag(h)
+    if central:
+        points = [x + e for e in steps] + [x - e for e in steps]
+        y = check_outputs(evaluate(points), points, dim)
+        return np.column_stack([(y[j] - y[dim + j]) / (2 * h[j]) for j in range(dim)])
+    points = [x + e for e in steps] + ([x] if base is None else [])
+    y = check_outputs(evaluate(points), points, dim)
+    y0 = np.asarray(base, dtype=float) if base is not None else y[dim]
+    return np.column_stack([(y[j] - y0) / h[j] for j in range(dim)])
+
+
+@dataclass(frozen=True)
+class FixedPoint:
+    """The result of `newton_fixed_point`: the state, the map there, |P(x) - x| / |x| after each iterate
+    (the first is the start's), and the last Jacobian (at the second-to-last iterate)."""
+
+    state: np.ndarray
+    image: np.ndarray
+    residuals: list[float]
+    jacobian: np.ndarray
+    iterations: int
+    converged: bool
+
+    @property
+    def residual(self) -> float:
+        return self.residuals[-1]
+
+
+def relative_residual(x: np.ndarray, y: np.ndarray) -> float:
+    """|P(x) - x| relative to |x|."""
+    return float(np.linalg.norm(y - x) / max(np.linalg.norm(x), 1e-300))
+
+
+def newton_fixed_point(evaluate: Batch, x0: np.ndarray, epsilon: float | Sequence[float],
+                       tolerance: float = 1e-8, max_iterations: int = 6, max_halvings: int = 4) -> FixedPoint:
+    """Solve P(x) = x by Newton's method: J = DP by central differences at each iterate, the step
+    (J - I)⁻¹ (x - P(x)) by an LU solve (scipy), halved while it does not reduce the residual. Stops when
+    the residual |P(x) - x| / |x| is below `tolerance`, after `max_iterations`, or when no halving of the
+    step helps (the map's own noise floor); returns the best iterate, converged or not."""
+    x = np.asarray(x0, dtype=float).reshape(-1)
+    dim = len(x)
+    (y,) = check_outputs(evaluate([x]), [x], dim)
+    residuals = [relative_residual(x, y)]
+    jac = np.full((dim, dim), np.nan)
+    it = 0
+    while residuals[-1] > tolerance and it < max_iterations:
+        jac = difference_jacobian(evaluate, x, epsilon)
+        step = scipy.linalg.lu_solve(scipy.linalg.lu_factor(jac - np.eye(dim)), x - y)
+        accepted = False
+        for _ in range(max_halvings + 1):
+            trial = x + step
+            try:
+                (yt,) = check_outputs(evaluate([trial]), [trial], dim)
+            except StepFailed:
+                step = 0.5 * step
+                continue
+            r = relative_residual(trial, yt)
+            if r < residuals[-1]:
+                x, y, accepted = trial, yt, True
+                residuals.append(r)
+                break
+            step = 0.5 * step
+        it += 1
+        if not accepted:
+            break
+    return FixedPoint(state=x, image=y, residuals=residuals, jacobian=jac, iterations=it,
+                      converged=residuals[-1] <= tolerance)
+
+
+def spectral_radius(jacobian: np.ndarray) -> float:
+    return float(np.max(np.abs(np.linalg.eigvals(jacobian))))
+
+
+def epsilon_sweep(evaluate: Batch, x: np.ndarray, epsilons: Sequence[float]) -> list[dict[str, Any]]:
+    """The central-difference Jacobian at `x` for each perturbation size: rows {epsilon, spectral_radius,
+    jacobian} (spectral_radius None where a perturbed step failed)."""
+    rows = []
+    for eps in epsilons:
+        try:
+            jac = difference_jacobian(evaluate, x, float(eps))
+        except StepFailed:
+            rows.append({"epsilon": float(eps), "spectral_radius": None, "jacobian": None})
+            continue
+        rows.append({"epsilon": float(eps), "spectral_radius": spectral_radius(jac), "jacobian": jac})
+    return rows
+
+
+def converged_epsilon(sweep: Sequence[dict[str, Any]], tolerance: float = 0.05) -> dict[str, Any]:
+    """Where the sweep's Jacobian has converged: the longest run of consecutive perturbation sizes whose
+    spectral radius changes by at most `tolerance` (relative) from one size to the next; the chosen ε is
+    the run's middle size (its geometric middle for an even run, the larger of the two). Returns the
+    chosen epsilon and its row's index, the plateau's bounds and its width in decades, and the largest
+    relative change inside it (None values when no two neighbouring sizes agree)."""
+    eps = [r["epsilon"] for r in sweep]
+    rho = [r["spectral_radius"] for r in sweep]
+    order = np.argsort(eps)
+    best: tuple[int, int] | None = None
+    start = None
+    for k in range(len(order) - 1):
+        a, b = rho[order[k]], rho[order[k + 1]]
+        ok = a is not None and b is not None and abs(b - a) <= tolerance * max(abs(a), abs(b), 1e-300)
+        if ok and start is None:
+            start = k
+        if start is not None and (not ok or k == len(order) - 2):
+            end = k + 1 if ok else k
+            if best is None or end - start > best[1] - best[0]:
+                best = (start, end)
+            start = None
+    if best is None:
+        return {"epsilon": None, "index": None, "plateau": None, "decades": 0.0, "max_change": None}
+    run = [int(order[k]) for k in range(best[0], best[1] + 1)]
+    mid = run[len(run) // 2]
+    changes = [abs(rho[run[i + 1]] - rho[run[i]]) / max(abs(rho[run[i]]), 1e-300) for i in range(len(run) - 1)]
+    lo, hi = eps[run[0]], eps[run[-1]]
+    return {"epsilon": eps[mid], "index": mid, "plateau": [lo, hi], "decades": float(np.log10(hi / lo)),
+            "max_change": float(max(changes))}
+
+
+@dataclass(frozen=True)
+class Multipliers:
+    """The eigenvalues of a step map's Jacobian, largest modulus first, with right eigenvectors (columns,
+    unit norm, largest component real and positive) and which ones are trivial."""
+
+    values: np.ndarray
+    vectors: np.ndarray
+    trivial: list[str | None] = field(default_factory=list)
+
+    @property
+    def spectral_radius(self) -> float:
+        return float(np.max(np.abs(self.values)))
+
+    def nontrivial_radius(self) -> float:
+        keep = [abs(v) for v, t in zip(self.values, self.trivial) if t is None]
+        return float(max(keep)) if keep else 0.0
+
+
+def multipliers(jacobian: np.ndarray, section_normal: np.ndarray | None = None,
+                alignment: float = 0.5) -> Multipliers:
+    """The Jacobian's eigenvalues (largest modulus first) and eigenvectors. With the section's normal ∇g,
+    the multiplier whose left eigenvector is most nearly parallel to it (|cos| ≥ `alignment`) is marked
+    "section" (the trivial multiplier of a Poincaré section: a shift along the flow)."""
+    values, left, right = scipy.linalg.eig(jacobian, left=True, right=True)
+    order = np.lexsort((-values.real, -np.abs(values)))
+    values, left, right = values[order], left[:, order], right[:, order]
+    for k in range(right.shape[1]):
+        v = right[:, k]
+        i = int(np.argmax(np.abs(v)))
+        v = v / np.linalg.norm(v)
+        right[:, k] = v * (abs(v[i]) / v[i])
+    trivial: list[str | None] = [None] * len(values)
+    if section_normal is not None:
+        n = np.asarray(section_normal, dtype=float)
+        n = n / np.linalg.norm(n)
+        cos = np.abs(n @ left) / np.linalg.norm(left, axis=0)
+        k = int(np.argmax(cos))
+        if cos[k] >= alignment:
+            trivial[k] = "section"
+    return Multipliers(values=values, vectors=right, trivial=trivial)
+
+
+def named_components(vector: np.ndarray, names: Sequence[str], count: int = 4) -> list[dict[str, Any]]:
+    """The largest components of a (unit) eigenvector, by name: [{name, re, im, magnitude}], largest first."""
+    v = np.asarray(vector)
+    order = np.argsort(-np.abs(v))[:count]
+    return [{"name": names[i], "re": float(v[i].real), "im": float(v[i].imag), "magnitude": float(abs(v[i]))}
+            for i in order]
+
+
+def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) -> np.ndarray:
+    """J^k δ for k = 1..steps, one row per step: the linearisation's prediction of a perturbation's
+    deviation from the fixed point after k steps."""
+    out, d = [], np.asarray(delta, dtype=float)
+    for _ in range(steps):
+        d = jacobian @ d
+        out.append(d)
+    return np.array(out)

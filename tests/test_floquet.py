@@ -1,0 +1,211 @@
+"""Floquet multipliers: the Newton / central-difference / eigen code on maps whose answer is known (a
+nonlinear map with chosen eigenvalues, Drake's passive rimless wheel with its analytic multiplier
+cos²(2α)), and the biped's step map through Drake (restarts reproduce the walk exactly, the held slots do
+not matter, the command writes what it promises)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from drake_biped.analysis import floquet as fq
+
+EIGENVALUES = np.array([0.6, -0.3, 0.5 + 0.4j, 0.5 - 0.4j])
+
+
+def _chosen_map():
+    """x -> x* + A (x - x*) + a cubic term: A has EIGENVALUES, the cubic spoils large perturbations."""
+    rng = np.random.default_rng(0)
+    basis = rng.normal(size=(4, 4))
+    block = np.diag([0.6, -0.3, 0.5, 0.5])
+    block[2, 3], block[3, 2] = 0.4, -0.4
+    a = basis @ block @ np.linalg.inv(basis)
+    x_star = np.array([0.3, -1.2, 2.0, 0.7])
+
+    def step(x):
+        d = x - x_star
+        return x_star + a @ d + 0.5 * d**3
+
+    return step, a, x_star
+
+
+def test_newton_finds_the_fixed_point_and_the_jacobian_its_eigenvalues():
+    step, a, x_star = _chosen_map()
+    evaluate = fq.serial(step)
+    fixed = fq.newton_fixed_point(evaluate, x_star + 0.05, 1e-6, tolerance=1e-12)
+    assert fixed.converged and fixed.residual < 1e-12
+    assert np.allclose(fixed.state, x_star, atol=1e-11)
+    assert fixed.residuals[0] > 1e-3 and fixed.iterations <= 5  # Newton: a few iterations, not a contraction
+    jac = fq.difference_jacobian(evaluate, fixed.state, 1e-5)
+    assert np.allclose(jac, a, atol=1e-8)
+    mult = fq.multipliers(jac)
+    expected = sorted(EIGENVALUES, key=lambda v: (-abs(v), -v.real))
+    assert np.allclose(sorted(mult.values, key=lambda v: (-abs(v), -v.real)), expected, atol=1e-8)
+    assert mult.spectral_radius == pytest.approx(abs(0.5 + 0.4j), abs=1e-8)
+    # eigenvectors: J v = λ v
+    for k in range(4):
+        assert np.allclose(jac @ mult.vectors[:, k], mult.values[k] * mult.vectors[:, k], atol=1e-7)
+
+
+def test_the_sweep_finds_the_plateau_between_rounding_and_the_cubic():
+    step, a, x_star = _chosen_map()
+    sweep = fq.epsilon_sweep(fq.serial(step), x_star, [10.0**e for e in range(-14, 1)])
+    chosen = fq.converged_epsilon(sweep, 0.05)
+    truth = abs(0.5 + 0.4j)
+    assert chosen["decades"] >= 2
+    assert 1e-12 <= chosen["epsilon"] <= 1e-1
+    assert sweep[chosen["index"]]["spectral_radius"] == pytest.approx(truth, rel=1e-4)
+    assert abs(sweep[-1]["spectral_radius"] - truth) > 0.05 * truth  # ε = 1: the cubic shows
+
+
+def test_converged_epsilon_takes_the_longest_run_and_reports_none_without_one():
+    rows = [{"epsilon": e, "spectral_radius": r} for e, r in
+            [(1e-8, 3.0), (1e-7, 1.0), (1e-6, 1.01), (1e-5, 1.02), (1e-4, 0.5), (1e-3, 0.51)]]
+    chosen = fq.converged_epsilon(rows, 0.05)
+    assert chosen["plateau"] == [1e-7, 1e-5] and chosen["epsilon"] == 1e-6 and chosen["decades"] == 2.0
+    none = fq.converged_epsilon([{"epsilon": e, "spectral_radius": r} for e, r in [(1e-6, 1), (1e-5, 2), (1e-4, 4)]])
+    assert none["epsilon"] is None
+
+
+def test_prediction_of_a_linear_map_is_exact():
+    rng = np.random.default_rng(1)
+    a = rng.normal(size=(3, 3)) * 0.4
+    delta = rng.normal(size=3)
+    predicted = fq.predicted_deviations(a, delta, 5)
+    d = delta
+    for k in range(5):
+        d = a @ d
+        assert np.allclose(predicted[k], d)
+
+
+def test_a_failed_step_is_reported():
+    with pytest.raises(fq.StepFailed, match="failed"):
+        fq.difference_jacobian(fq.serial(lambda x: None if x[0] > 0 else x), np.zeros(2), 0.1)
+
+
+# --- Drake's passive rimless wheel: multiplier cos²(2α) ------------------------------------------------
+def _rimless_wheel():
+    from pydrake.examples import RimlessWheel, RimlessWheelParams
+    from pydrake.systems.analysis import Simulator
+
+    wheel = RimlessWheel()
+    simulator = Simulator(wheel)
+    params = RimlessWheelParams()
+    slope = params.slope()
+    dt = 1e-3
+
+    def state(context):
+        return context.get_continuous_state_vector().CopyToVector()
+
+    def step(x):
+        """(θ, θ̇) -> the state at the next crossing of θ = slope (mid-stance) after an impact."""
+        context = simulator.get_mutable_context()
+        wheel.SetDefaultContext(context)
+        context.SetTime(0.0)
+        context.SetAccuracy(1e-12)
+        simulator.get_mutable_integrator().set_target_accuracy(1e-12)
+        context.get_mutable_continuous_state_vector().SetFromVector(x)
+        simulator.Initialize()
+        previous, impacted, k = state(context), False, 0
+        while k < 5000:
+            k += 1
+            simulator.AdvanceTo(k * dt)
+            now = state(context)
+            if now[0] < previous[0] - 0.3:
+                impacted = True
+            elif impacted and previous[0] < slope <= now[0]:
+                # cubic Hermite between the two samples (θ̈ = g/l sin θ gives no better end data)
+                (p0, v0), (p1, v1) = previous, now
+                s = (slope - p0) / (p1 - p0)
+                for _ in range(50):
+                    h = (2 * s**3 - 3 * s**2 + 1) * p0 + (s**3 - 2 * s**2 + s) * dt * v0 + \
+                        (-2 * s**3 + 3 * s**2) * p1 + (s**3 - s**2) * dt * v1 - slope
+                    dh = (6 * s**2 - 6 * s) * p0 + (3 * s**2 - 4 * s + 1) * dt * v0 + \
+                        (-6 * s**2 + 6 * s) * p1 + (3 * s**2 - 2 * s) * dt * v1
+                    s -= h / dh
+                rate = ((6 * s**2 - 6 * s) * p0 + (3 * s**2 - 4 * s + 1) * dt * v0 +
+                        (-6 * s**2 + 6 * s) * p1 + (3 * s**2 - 2 * s) * dt * v1) / dt
+                return np.array([slope, rate])
+            previous = now
+        return None
+
+    return step, params
+
+
+@pytest.mark.slow
+def test_the_rimless_wheel_multiplier_is_cos_squared_two_alpha():
+    step, params = _rimless_wheel()
+    alpha = math.pi / params.number_of_spokes()
+    slope, g_over_l = params.slope(), params.gravity() / params.length()
+    post = math.sqrt(4 * g_over_l * math.sin(alpha) * math.sin(slope)) / math.tan(2 * alpha)
+    mid = math.sqrt(post**2 + 2 * g_over_l * (math.cos(slope - alpha) - math.cos(slope)))
+    evaluate = fq.serial(step)
+    fixed = fq.newton_fixed_point(evaluate, np.array([slope, 1.2 * mid]), 1e-5, tolerance=1e-9)
+    assert fixed.converged
+    assert fixed.state[1] == pytest.approx(mid, rel=1e-5)
+    jac = fq.difference_jacobian(evaluate, fixed.state, 1e-5)
+    mult = fq.multipliers(jac, section_normal=np.array([1.0, 0.0]))
+    assert mult.values[0].real == pytest.approx(math.cos(2 * alpha) ** 2, abs=1e-4)
+    assert mult.trivial == [None, "section"] and abs(mult.values[1]) < 1e-6
+
+
+# --- the biped's step map through Drake ----------------------------------------------------------------
+@pytest.fixture(scope="module")
+def biped_map():
+    from drake_biped.analysis.step_map import SectionMap
+    from drake_biped.params import EpisodeConfig
+
+    section_map = SectionMap(EpisodeConfig())
+    z0, template = section_map.start(6)
+    return section_map, z0, template
+
+
+@pytest.mark.slow
+def test_the_step_map_is_deterministic_and_packs_losslessly(biped_map):
+    section_map, z0, template = biped_map
+    assert np.array_equal(section_map.pack(section_map.unpack(z0, template)), z0)
+    assert np.allclose(section_map.unpack(z0, template).plant, template.plant, atol=1e-12)
+    a, b = section_map.step(z0), section_map.step(z0)
+    assert np.array_equal(a, b)
+    # on the section the hip is over the stance ankle: the stance thigh is vertical (knee at its stop)
+    assert abs(z0[section_map.names.index("stance_thigh_rad")]) < 1e-3
+
+
+@pytest.mark.slow
+def test_the_held_slots_do_not_change_the_map(biped_map):
+    from drake_biped import controller as ctl
+    from drake_biped.analysis.step_map import Snapshot
+
+    section_map, z0, template = biped_map
+    base = section_map.step(z0, template)
+    c = template.controller.copy()
+    for slot in (ctl.Q_PREV, ctl.Q_PREV + 4, ctl.PREV_PITCH, ctl.PREV_CLEARANCE, ctl.PREV_RATES,
+                 ctl.POSITIVE_WORK, ctl.SIGNED_WORK + 2, ctl.COM_X):
+        c[slot] += 0.01
+    shifted = Snapshot(template.time_s, template.plant, template.torques, c)
+    assert np.array_equal(section_map.step(z0, shifted), base)
+
+
+@pytest.mark.slow
+def test_floquet_command_writes_its_record(tmp_path):
+    from drake_biped import cli
+
+    out = tmp_path / "fl"
+    assert cli.main(["floquet", "--epsilons", "1e-7,1e-6,1e-5", "--workers", "1",
+                     "--out", str(out)]) == 0
+    record = json.loads((out / "floquet.json").read_text())
+    names = record["coordinates"]
+    assert len(record["multipliers"]) == len(names) == len(record["fixed_point"])
+    assert record["trivial"].count("section") == 1
+    assert record["fixed_point_residual"] < 1e-3
+    assert [r["epsilon"] for r in record["epsilon_sweep"]] == [1e-7, 1e-6, 1e-5]
+    assert record["converged_epsilon"] is not None
+    rho = [r["spectral_radius"] for r in record["epsilon_sweep"]]
+    assert max(rho) - min(rho) <= 0.05 * max(rho)
+    assert record["spectral_radius"] == pytest.approx(max(math.hypot(*m) for m in record["multipliers"]))
+    # the map iterated follows the linearisation over the checked steps
+    ratios = record["decay"]["map_iterated_ratio"]
+    assert all(0.8 < r < 1.25 for r in ratios)
+    assert record["versions"]["drake"] and record["config"]["window"]["end_s"] == 0.0
+    assert (out / "floquet.png").stat().st_size > 0 and "Spectral radius" in (out / "floquet.md").read_text()
