@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+import re
 from pathlib import Path
 
 import matplotlib
@@ -27,8 +28,8 @@ def markdown_cell(text: str) -> str:
 
 def _eig_text(pairs) -> str:
     out = []
-    for re, im in pairs:
-        out.append(f"{re:.3f}" if abs(im) < 5e-4 else f"{re:.3f}{'+' if im >= 0 else '−'}{abs(im):.3f}i")
+    for real, im in pairs:
+        out.append(f"{real:.3f}" if abs(im) < 5e-4 else f"{real:.3f}{'+' if im >= 0 else '−'}{abs(im):.3f}i")
     return ", ".join(out)
 
 
@@ -169,9 +170,29 @@ def report_markdown(record: dict) -> str:
                   "|" + "---|" * len(JACOBIAN_COLUMNS)]
         lines += ["| " + " | ".join(markdown_cell(c) for c in row) + " |" for row in jac_rows]
         lines.append("")
+    lines += _floquet_sections(record)
     v = record.get("versions", {})
     lines.append(f"drake-biped {v.get('drake_biped', '?')} ({v.get('git_commit', '?')}), Drake {v.get('drake', '?')}.")
     return "\n".join(lines) + "\n"
+
+
+FLOQUET_TEXT = ("The full-state linearisation of the gait beside the 2-D regression: the fixed point of the step "
+                "map on the mid-stance section and its multipliers (`drake-biped floquet`), without and with the "
+                "window. The regression is fitted over pushes, deviations of 10⁻²–10⁻¹; the multipliers are the "
+                "map's derivative at the orbit, where the sweep of ε converges.")
+
+
+def _floquet_sections(record: dict) -> list[str]:
+    """The Floquet sections (`stability --floquet`), as floquet.md writes them."""
+    found = record.get("floquet") or {}
+    if not found:
+        return []
+    lines = ["## Floquet multipliers of the periodic orbit, beside the regression", "", FLOQUET_TEXT, ""]
+    for condition in ("without", "with"):
+        if condition in found:
+            text = re.sub(r"^(#+) ", lambda m: "#" + m.group(1) + " ", found[condition]["markdown"], flags=re.M)
+            lines += [text, f"![Floquet multipliers, {condition}](floquet_{condition}/floquet.png)", ""]
+    return lines
 
 
 def report_html(record: dict) -> str:
@@ -187,7 +208,7 @@ def report_html(record: dict) -> str:
         f"<p>{intro}</p><table><tr>{head}</tr>{body}</table>"
         "<p>A cell is stable when the spectral radius ρ of its fitted return map is below 1 and no trial fell.</p>"
         "<img src='fig7_return_map.png' alt='Fig. 7' style='max-width:100%'>"
-        + _jacobian_html(record) +
+        + _jacobian_html(record) + _floquet_html(record) +
         "</body></html>\n"
     )
 
@@ -209,3 +230,12 @@ def write_stability_outputs(record: dict, out: str | Path) -> list[Path]:
     write_text_atomic(paths[1], report_markdown(record))
     write_text_atomic(paths[2], report_html(record))
     return paths
+
+
+def _floquet_html(record: dict) -> str:
+    lines = _floquet_sections(record)
+    if not lines:
+        return ""
+    import markdown
+
+    return markdown.markdown("\n".join(lines), extensions=["tables"])

@@ -76,13 +76,14 @@ class Snapshot:
         return self.controller[ctl.STANCE_RIGHT] > 0.5
 
     def to_dict(self) -> dict[str, Any]:
+        """Plain JSON: a non-finite controller slot (the distance target, a lagged value not yet read) as None."""
         return {"time_s": self.time_s, "plant": self.plant.tolist(), "torques": self.torques.tolist(),
-                "controller": [float(v) for v in self.controller]}
+                "controller": [float(v) if math.isfinite(v) else None for v in self.controller]}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Snapshot:
         return cls(float(d["time_s"]), np.array(d["plant"], float), np.array(d["torques"], float),
-                   np.array(d["controller"], float))
+                   np.array([math.nan if v is None else v for v in d["controller"]], float))
 
 
 class SectionMap:
@@ -236,7 +237,9 @@ class SectionMap:
         as this map's template)."""
         if not isinstance(steps, int) or steps < 1:
             raise ParameterError(f"steps {steps!r}: must be an integer >= 1")
-        reset_context(self._parts, self._simulator, self.config)
+        _, ctrl_ctx, _ = reset_context(self._parts, self._simulator, self.config)
+        # walk as far as the section needs, whatever distance the episode would walk
+        ctrl_ctx.get_mutable_discrete_state(self._parts.controller.state_group).SetAtIndex(ctl.TARGET_X, math.inf)
         self._simulator.Initialize()
         found = self._to_section(steps, 0, self.config.sim.max_time_s)
         if found is None:

@@ -282,7 +282,7 @@ def cmd_stability(args: argparse.Namespace) -> int:
                                            push_force_n=args.push, spread=args.spread, seed=config.seed)
     out = Path(args.out)
     with _client(args) as client:
-        stability.run(settings, out, client, config=config)
+        stability.run(settings, out, client, config=config, floquet=args.floquet)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
     print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
     return 0
@@ -561,6 +561,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_window_options(stab)
     stab.add_argument("--trials", type=_count, default=8, help="trials per cell (default 8)")
     stab.add_argument("--push", type=_number("positive"), default=20.0, help="push force (N); default 20")
+    stab.add_argument("--floquet", action="store_true",
+                      help="also the periodic orbit's Floquet multipliers without and with the window (about a "
+                      "minute each on 2 cores), in the report beside the regression")
     stab.add_argument("--spread", type=_number("nonnegative"), default=0.15,
                       help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
     _add_resumable_run_options(stab)

@@ -209,3 +209,10 @@ def test_floquet_command_writes_its_record(tmp_path):
     assert all(0.8 < r < 1.25 for r in ratios)
     assert record["versions"]["drake"] and record["config"]["window"]["end_s"] == 0.0
     assert (out / "floquet.png").stat().st_size > 0 and "Spectral radius" in (out / "floquet.md").read_text()
+    # the stability report's section (`stability --floquet`) carries the same text, headings one level down
+    from drake_biped.analysis.stability_report import _floquet_sections
+    from drake_biped.experiments import floquet
+
+    section = "\n".join(_floquet_sections({"floquet": {"without": {"markdown": floquet.markdown(record)}}}))
+    assert "#### Floquet multipliers of the periodic orbit (no torque-free period)" in section
+    assert f"{record['spectral_radius']:.4f}" in section and "floquet_without/floquet.png" in section

@@ -13,6 +13,7 @@ functions as its own command:
     compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
     stability/       pushes and return maps, none vs 0.2-0.5 s (Table VI, Fig. 7)
     push_margin/     the largest pushes survived, none vs 0.2-0.5 s
+    floquet/         the periodic orbit's Floquet multipliers: none, 0.2-0.5 s, and the learned window
     slope_default/   the default gait at the foot of 0.02 rad
     grid_slope/      forward lean and placement on 0.02 rad; grid_slope2deg/ on 2.0 deg (our Table VII)
     slope/, slope2deg/  the slope story with the climbing gaits (Figs. 8-11)
@@ -69,6 +70,7 @@ class Profile:
     time_step_distance_m: float
     expected_minutes: float  # on 2 cores
     compare: tuple[int, int] = (1, 6)  # trials, episodes per learner in the side-by-side comparison
+    floquet_epsilons: tuple[float, ...] = ()  # the Floquet sweep's perturbations (empty: its default)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -266,6 +268,34 @@ class Reproduction:
         return self.experiment("push_margin", {"tolerance_n": tol, "window": list(LEVEL_WINDOW),
                                                "distance_m": self.profile.distance_m}, run)
 
+    def floquet(self) -> dict:
+        from drake_biped.experiments import floquet
+        from drake_biped.experiments.learning import best_learned_trial
+
+        windows = {"none": (0.0, 0.0), "window": LEVEL_WINDOW}
+        for source in ("learn", "learn_variant"):  # the learned window: the paper's settings' if they learned one
+            try:
+                row = best_learned_trial(json.loads((self.out / source / "learning.json").read_text()), source)
+            except (OSError, ValueError):
+                continue
+            windows["learned"] = (max(0.0, float(row["t1"])), max(0.0, float(row["t2"])))
+            break
+
+        def run(folder: Path) -> dict:
+            out = {}
+            for name, (t1, t2) in windows.items():
+                config = self.level.replace(window=TorqueFreeWindow(t1, t2))
+                eps = {"epsilons": tuple(self.profile.floquet_epsilons)} if self.profile.floquet_epsilons else {}
+                record = floquet.run(floquet.FloquetSettings(config, **eps), folder / name, self._client)
+                out[name] = {"window": [t1, t2], **{k: record[k] for k in (
+                    "spectral_radius", "converged_epsilon", "fixed_point_residual", "multipliers", "plateau",
+                    "sampling_phase_drift")}, "decay": {k: record["decay"][k] for k in (
+                        "predicted", "map_iterated", "continued")}, "wall_time_s": record["wall_time_s"]}
+            return {"gaits": out}
+
+        return self.experiment("floquet", {"windows": {k: list(v) for k, v in windows.items()},
+                                           "distance_m": self.profile.distance_m}, run)
+
     def slope_default(self) -> dict:
         from drake_biped.experiments.executor import run_kept
         from drake_biped.experiments.slope import climbs, slope_ground
@@ -332,7 +362,7 @@ class Reproduction:
         return self._slope("slope2deg", "climbing_2deg", SLOPE_2DEG_RAD_PRINTED)
 
     STEPS = ("walk", "time_step", "grid", "paper_gait", "window_map", "learn", "learn_variant", "compare_learners",
-             "stability", "push_margin", "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
+             "stability", "push_margin", "floquet", "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
 
     def run_all(self) -> dict[str, dict]:
         self.out.mkdir(parents=True, exist_ok=True)

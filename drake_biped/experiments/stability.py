@@ -295,10 +295,12 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle
 
 
 def run(settings: StabilitySettings, out: Path, client=None, progress: bool = True, config: EpisodeConfig | None = None,
-        jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD) -> dict[str, Any]:
+        jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD, floquet: bool = False) -> dict[str, Any]:
     """The six cells and the Jacobians of `config`'s gait (the default gait when None) on `client` (a
     LocalCluster when None), with a progress bar; writes episodes/, stability.json, fig7_return_map.png,
-    report.md and report.html into `out`. The record."""
+    report.md and report.html into `out`. `floquet`: also the periodic orbit's Floquet multipliers without
+    and with the window (experiments/floquet.py; floquet_without/, floquet_with/ and a report section). The
+    record."""
     from drake_biped.analysis.stability_report import write_stability_outputs
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.records import write_atomic
@@ -322,6 +324,18 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     finally:
         if bar is not None:
             bar.close()  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
+    if floquet:
+        from drake_biped.experiments import floquet as floquet_experiment
+
+        record["floquet"] = {}
+        for condition in CONDITIONS:
+            gait = config.replace(window=condition_window(condition, settings.window))
+            with client_or_local(client) as c:
+                f = floquet_experiment.run(floquet_experiment.FloquetSettings(gait), out / f"floquet_{condition}", c)
+            record["floquet"][condition] = {
+                "spectral_radius": f["spectral_radius"], "multipliers": f["multipliers"],
+                "converged_epsilon": f["converged_epsilon"], "fixed_point_residual": f["fixed_point_residual"],
+                "markdown": floquet_experiment.markdown(f)}
     write_atomic(out / "stability.json", record)
     write_stability_outputs(record, out)
     return record
