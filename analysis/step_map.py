@@ -133,8 +133,8 @@ class SectionMap:
         # the template's stance foot: ankle point, foot angle, and their rates
         th0, dth0 = tq[2] + tq[hip], tv[2] + tv[hip]
         sh0, dsh0 = th0 - tq[knee], dth0 - tv[knee]
-        ax = tq[0] + THIGH_M * math.sin(th0) + SHANK_M * math.sin(sh0)
-        az = tq[1] - THIGH_M * math.cos(th0) - SHANK_M * math.cos(sh0)
+        stance = leg_points(tq[0], tq[1], tq[2], tq[hip], tq[knee], tq[ankle])
+        ax, az = stance.ankle_x, stance.ankle_z
         dax = tv[0] + THIGH_M * math.cos(th0) * dth0 + SHANK_M * math.cos(sh0) * dsh0
         daz = tv[1] + THIGH_M * math.sin(th0) * dth0 + SHANK_M * math.sin(sh0) * dsh0
         foot, dfoot = sh0 + tq[ankle], dsh0 + tv[ankle]
@@ -142,9 +142,9 @@ class SectionMap:
         sh, dsh = th - tq[knee], dth - tv[knee]
         plant = template.plant.copy()
         q, v = plant[:9], plant[9:]
-        q[0] = ax - THIGH_M * math.sin(th) - SHANK_M * math.sin(sh)
-        q[1] = az + THIGH_M * math.cos(th) + SHANK_M * math.cos(sh)
         q[2], q[hip], q[ankle] = pitch, th - pitch, foot - sh
+        leg = leg_points(0.0, 0.0, pitch, q[hip], q[knee], q[ankle])  # the ankle relative to the hip
+        q[0], q[1] = ax - leg.ankle_x, az - leg.ankle_z
         v[0] = dax - THIGH_M * math.cos(th) * dth - SHANK_M * math.cos(sh) * dsh
         v[1] = daz - THIGH_M * math.sin(th) * dth - SHANK_M * math.sin(sh) * dsh
         v[2], v[hip], v[ankle] = dpitch, dth - dpitch, dfoot - dsh
@@ -160,11 +160,14 @@ class SectionMap:
         return Snapshot(0.0, plant, template.torques.copy(), c)
 
     def section_normal(self) -> np.ndarray:
-        """∇g in section coordinates: with the stance knee held at the template's angle, g depends on the
-        stance thigh's world angle alone."""
+        """∇g in section coordinates at the template: with the stance knee held at the template's angle,
+        g = −(THIGH sin θ + SHANK sin(θ − knee)) depends on the stance thigh's world angle θ alone."""
+        if self.template is None:
+            raise RuntimeError("SectionMap: call start() first")
+        q = self.template.plant
+        knee = q[3 + _legs(self.template.stance_right)[0][1]]
+        th = self.pack(self.template)[1]
         grad = np.zeros(len(self.names))
-        knee = self.template.plant[3 + _legs(self.template.stance_right)[0][1]] if self.template else 0.0
-        th = 0.0
         grad[1] = -(THIGH_M * math.cos(th) + SHANK_M * math.cos(th - knee))
         return grad
 
@@ -201,9 +204,9 @@ class SectionMap:
             return None
         return snap
 
-    def _to_section(self, touchdowns: int, k: int, limit_s: float) -> tuple[Snapshot, float] | None:
+    def _to_section(self, touchdowns: int, k: int, limit_s: float) -> Snapshot | None:
         """From update k, run until `touchdowns` touchdowns are counted and then to the section, for at
-        most `limit_s`; return the interpolated snapshot there and the fraction of the control period."""
+        most `limit_s`; the snapshot interpolated there."""
         k_limit = k + int(math.ceil(limit_s / self._dt))
         snap = self._snapshot()
         while snap.controller[ctl.STEP_COUNT] < touchdowns:
@@ -226,10 +229,10 @@ class SectionMap:
                     (1 - f) * previous.torques + f * snap.torques,
                     (1 - f) * previous.controller + f * snap.controller,
                 )
-                mix.controller[ctl.STANCE_RIGHT] = snap.controller[ctl.STANCE_RIGHT]
-                mix.controller[ctl.STEP_COUNT] = snap.controller[ctl.STEP_COUNT]
-                mix.controller[ctl.STEP_START] = snap.controller[ctl.STEP_START]
-                return mix, f
+                # the slots no update changes mid-stance, copied rather than rounded by the blend
+                for slot in (ctl.STANCE_RIGHT, ctl.STEP_COUNT, ctl.STEP_START):
+                    mix.controller[slot] = snap.controller[slot]
+                return mix
             previous, g_prev = snap, g
 
     def start(self, steps: int = 8) -> tuple[np.ndarray, Snapshot]:
@@ -244,8 +247,8 @@ class SectionMap:
         found = self._to_section(steps, 0, self.config.sim.max_time_s)
         if found is None:
             raise ParameterError(f"the gait does not reach the section after touchdown {steps}: it falls")
-        self.template = found[0]
-        return self.pack(found[0]), found[0]
+        self.template = found
+        return self.pack(found), found
 
     def step(self, z: np.ndarray, template: Snapshot | None = None) -> np.ndarray | None:
         """The next section state from section state `z` (None: a fall, or no section within max_step_s)."""
@@ -267,8 +270,7 @@ class SectionMap:
             found = self._to_section(count + n, k, self._max_step_s)
             if found is None:
                 return None
-            mix, f = found
-            out.append(self.pack(mix))
+            out.append(self.pack(found))
             k = int(round(self._simulator.get_context().get_time() / self._dt))
         return out
 
@@ -276,10 +278,8 @@ class SectionMap:
 _MAPS: dict[str, SectionMap] = {}
 
 
-def evaluate_task(config: dict[str, Any], template: dict[str, Any], points: list[list[float]],
-                  steps: int = 1) -> list[list[float] | None]:
-    """On a worker: the map (`steps` = 1) or the last of `steps` sections from each point (None: a fall).
-    The worker keeps one SectionMap per configuration."""
+def evaluate_task(config: dict[str, Any], template: dict[str, Any], points: list[list[float]]) -> list[list[float] | None]:
+    """On a worker: the map at each point (None: a fall). The worker keeps one SectionMap per configuration."""
     key = json.dumps(config, sort_keys=True)
     if key not in _MAPS:
         _MAPS.clear()
@@ -288,6 +288,6 @@ def evaluate_task(config: dict[str, Any], template: dict[str, Any], points: list
     snap = Snapshot.from_dict(template)
     out: list[list[float] | None] = []
     for p in points:
-        traj = section_map.trajectory(np.array(p, dtype=float), steps, snap)
-        out.append(None if traj is None else [float(v) for v in traj[-1]])
+        y = section_map.step(np.array(p, dtype=float), snap)
+        out.append(None if y is None else [float(v) for v in y])
     return out

@@ -173,6 +173,30 @@ def test_the_step_map_is_deterministic_and_packs_losslessly(biped_map):
 
 
 @pytest.mark.slow
+def test_a_restart_from_an_update_continues_the_walk_exactly(biped_map):
+    """The map's restart (defaults, then the plant, torques and controller state set) loses nothing: from a
+    snapshot taken at an update, with its clocks moved to time 0, the walk to the next section is the
+    walk that continued, to the bit."""
+    from drake_biped import controller as ctl
+    from drake_biped.analysis.step_map import Snapshot
+
+    section_map, z0, template = biped_map
+    section_map.step(z0)  # leaves the simulator just past the next section
+    k = int(round(section_map._simulator.get_context().get_time() / section_map._dt)) + 1
+    snap = section_map._advance(k)
+    target = int(snap.controller[ctl.STEP_COUNT]) + 1
+    continued = section_map._to_section(target, k, 3.0)
+    c = snap.controller.copy()
+    c[ctl.STEP_START] -= snap.time_s
+    c[ctl.STATE_TIME] -= snap.time_s
+    section_map._restore(Snapshot(0.0, snap.plant, snap.torques, c))
+    section_map._simulator.Initialize()
+    restarted = section_map._to_section(target, 0, 3.0)
+    assert np.array_equal(restarted.plant, continued.plant)
+    assert restarted.time_s == pytest.approx(continued.time_s - snap.time_s, abs=1e-12)
+
+
+@pytest.mark.slow
 def test_the_held_slots_do_not_change_the_map(biped_map):
     from drake_biped import controller as ctl
     from drake_biped.analysis.step_map import Snapshot

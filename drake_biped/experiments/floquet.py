@@ -63,17 +63,17 @@ class FloquetSettings:
                 "decay_steps": self.decay_steps, "decay_size": self.decay_size}
 
 
-def _batch(client, config: dict[str, Any], template: dict[str, Any], steps: int = 1) -> fq.Batch:
+def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
     """A batch evaluator of the step map on `client`: the points split evenly over its workers."""
     from drake_biped.analysis.step_map import evaluate_task
 
-    workers = max(1, len(client.scheduler_info().get("workers", {})) or 1)
+    workers = max(1, len(client.scheduler_info()["workers"]))
 
     def evaluate(points):
         points = [np.asarray(p, dtype=float).tolist() for p in points]
         size = max(1, math.ceil(len(points) / (2 * workers)))
         chunks = [points[i : i + size] for i in range(0, len(points), size)]
-        futures = [client.submit(evaluate_task, config, template, chunk, steps, pure=False) for chunk in chunks]
+        futures = [client.submit(evaluate_task, config, template, chunk, pure=False) for chunk in chunks]
         out = []
         for part in client.gather(futures):
             out.extend(None if y is None else np.array(y) for y in part)

@@ -321,21 +321,26 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
         with client_or_local(client) as c:
             record = run_stability(out, config, settings, c, report if bar is not None else None,
                                    jacobian_kicks=jacobian_kicks)
+            if floquet:
+                record["floquet"] = _floquet(config, settings.window, out, c)
     finally:
         if bar is not None:
             bar.close()  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
-    if floquet:
-        from drake_biped.experiments import floquet as floquet_experiment
-
-        record["floquet"] = {}
-        for condition in CONDITIONS:
-            gait = config.replace(window=condition_window(condition, settings.window))
-            with client_or_local(client) as c:
-                f = floquet_experiment.run(floquet_experiment.FloquetSettings(gait), out / f"floquet_{condition}", c)
-            record["floquet"][condition] = {
-                "spectral_radius": f["spectral_radius"], "multipliers": f["multipliers"],
-                "converged_epsilon": f["converged_epsilon"], "fixed_point_residual": f["fixed_point_residual"],
-                "markdown": floquet_experiment.markdown(f)}
     write_atomic(out / "stability.json", record)
     write_stability_outputs(record, out)
     return record
+
+
+def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, client) -> dict[str, Any]:
+    """The Floquet analysis (experiments/floquet.py) without and with the window, into floquet_CONDITION/;
+    what the report shows of each."""
+    from drake_biped.experiments import floquet
+
+    found = {}
+    for condition in CONDITIONS:
+        gait = config.replace(window=condition_window(condition, window))
+        f = floquet.run(floquet.FloquetSettings(gait), out / f"floquet_{condition}", client)
+        found[condition] = {k: f[k] for k in ("spectral_radius", "multipliers", "converged_epsilon",
+                                              "fixed_point_residual")}
+        found[condition]["markdown"] = floquet.markdown(f)
+    return found
