@@ -25,9 +25,13 @@ swing foot's clearance crossed the touchdown height, interpolated between two up
 CPG phase and the torque-free window all count from T_n; the section angle is interpolated to T_n and the
 section rate extrapolated to T_n from the two updates before it (before the impact, which a 1 ms update
 would otherwise sample at a random depth); and a control period that a window edge cuts applies the
-servo's torque scaled by the part of the period outside the window; and a switch of the swing knee's
+servo's torque scaled by the part of the period outside the window; a switch of the swing knee's
 bang-bang torque that falls inside a period (its condition crossed along the state extrapolated over the
-period) blends the two torques by the part of the period each holds. tests/test_hot_path.py and tests/test_gait.py pin this down.
+period) blends the two torques by the part of the period each holds; and the roles' torques swap at the
+crossing itself: where the clearance, extrapolated over the coming period, crosses the touchdown height
+inside it, that period's torques blend the present roles' and the new roles' by the part of the period
+each holds (GaitParams.swap_timing "predicted"; "update" swaps them at the update that sees the crossing).
+tests/test_hot_path.py and tests/test_gait.py pin this down.
 """
 
 from __future__ import annotations
@@ -168,6 +172,7 @@ class CpgWalkingController(LeafSystem):
         self._window = config.window
         self._amplitude = config.cpg.swing_amplitude_rad
         self._integrated = config.gait.swing_reading == "integrated"
+        self._predicted_swap = config.gait.swap_timing == "predicted"
         self._fall_height = config.sim.fall_hip_height_m
         self._fall_pitch = config.sim.fall_pitch_rad
 
@@ -228,6 +233,79 @@ class CpgWalkingController(LeafSystem):
         rows = context.get_discrete_state(self._touchdown_group).value()[: n * _TD]
         return rows.reshape(n, _TD).copy()
 
+    def _predicted_touchdown(self, s, now: float, clearance: float, c_prev: float, advance: float,
+                             stance_ankle_rate: float):
+        """The part of the coming control period before the swing foot's clearance, extrapolated linearly
+        from this update and the previous one, crosses the touchdown height, when the touchdown would be
+        confirmed at the period's end; None when no touchdown is predicted in it."""
+        g = self._gait
+        thr = g.touchdown_height_m
+        if not (math.isfinite(c_prev) and clearance > thr):
+            return None
+        c_end = 2.0 * clearance - c_prev
+        if c_end >= thr:
+            return None
+        gamma_end = cpg.advance_phase(self._cpg, s[GAMMA], stance_ankle_rate, self._dt)
+        if not gait.is_touchdown(g, now + self._dt - s[STEP_START], c_end, advance, gamma_end):
+            return None
+        return (clearance - thr) / (clearance - c_end)
+
+    def _period_torques(self, s, q, v, now: float, stance_right: bool, stance, swing) -> None:
+        """The six torques over the period [now, now + dt) for the given roles, into s[TAU:], advancing
+        the CPG phase, the swing travel, the hip integrator and the gate in s."""
+        g = self._gait
+        dt = self._dt
+        ground = self._ground
+        st_i, sw_i = _LEG_Q[stance_right]
+        px, pitch, pitch_rate = q[0], q[2], v[2]
+        # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
+        elapsed = now - s[STEP_START]
+
+        # CPG (eq. 2-3) and the swing reference.
+        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + ANKLE], dt)
+        zeta = cpg.output(self._cpg, gamma)
+        s[GAMMA] = gamma
+        s[TRAVEL] += dt * zeta
+        if self._integrated:
+            # Table III's zeta drives the swing as printed: the reference angle is its integral from the
+            # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
+            offset = g.swing_offset_rad + gait.placement_feedback(g, px - stance.ankle_x, v[0])
+            reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
+        else:
+            target = gait.placement_target(g, self._amplitude, px - stance.ankle_x, v[0])
+            reference = cpg.swing_reference(gamma, s[LIFTOFF_ANGLE], target)
+        swing_rate = pitch_rate + v[sw_i]
+        angle_error = reference - swing.thigh_angle
+
+        # Torque-free gate: the servo's torque scaled by the part of the period outside the window (exactly
+        # zero for a period inside it), the integrator advanced by that part only.
+        free = 0.0
+        if s[STEP_COUNT] >= self._window.first_step:
+            free = cpg.torque_free_fraction(elapsed, dt, self._window.start_s, self._window.end_s)
+        if free >= 1.0:
+            tau_swing_hip = 0.0
+        else:
+            s[INTEGRAL] += angle_error * dt * (1.0 - free)
+            tau_swing_hip = (1.0 - free) * gait.clip(
+                gait.hip_servo_torque(g, angle_error, zeta - swing_rate, s[INTEGRAL]), _HIP_LIMIT
+            )
+        s[GATE] = free
+        tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
+
+        a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
+        s[a_sw] = tau_swing_hip
+        s[a_st] = tau_stance_hip
+        # the swing knee's switches placed inside the period, along the state extrapolated over it
+        knee_start = (gamma, q[sw_i + KNEE], swing.thigh_angle)
+        knee_end = (cpg.advance_phase(self._cpg, gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
+                    swing.thigh_angle + dt * swing_rate)
+        s[a_sw + KNEE] = gait.clip(gait.swing_knee_torque_over(g, knee_start, knee_end), _KNEE_LIMIT)
+        s[a_st + KNEE] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
+        for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
+            foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
+            slope = ground.slope_at(leg.ankle_x)
+            s[a + ANKLE] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
+
     def _update(self, context, discrete_state):
         t = context.get_time()
         x = self._plant_state.Eval(context).tolist()
@@ -276,7 +354,8 @@ class CpgWalkingController(LeafSystem):
         rate_1, rate_2 = s[PREV_RATES], s[PREV_RATES + 1]
         s[PREV_RATES + 1] = rate_1
         s[PREV_RATES] = v[sw_i] - v[st_i]  # the section rate, were the swing foot to land now
-        if gait.is_touchdown(g, now - s[STEP_START], clearance, advance, s[GAMMA]):
+        touched = gait.is_touchdown(g, now - s[STEP_START], clearance, advance, s[GAMMA])
+        if touched:
             stance_right = not stance_right
             st_i, sw_i = sw_i, st_i
             stance, swing = swing, stance
@@ -312,53 +391,29 @@ class CpgWalkingController(LeafSystem):
             s[INTEGRAL] = 0.0
             s[TRAVEL] = back * cpg.output(self._cpg, 0.5 * s[GAMMA])
 
-        # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
-        elapsed = now - s[STEP_START]
-
-        # CPG (eq. 2-3) and the swing reference.
-        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + ANKLE], dt)
-        zeta = cpg.output(self._cpg, gamma)
-        s[GAMMA] = gamma
-        s[TRAVEL] += dt * zeta
-        if self._integrated:
-            # Table III's zeta drives the swing as printed: the reference angle is its integral from the
-            # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
-            offset = g.swing_offset_rad + gait.placement_feedback(g, px - stance.ankle_x, v[0])
-            reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
-        else:
-            target = gait.placement_target(g, self._amplitude, px - stance.ankle_x, v[0])
-            reference = cpg.swing_reference(gamma, s[LIFTOFF_ANGLE], target)
-        swing_rate = pitch_rate + v[sw_i]
-        angle_error = reference - swing.thigh_angle
-
-        # Torque-free gate: the servo's torque scaled by the part of the period outside the window (exactly
-        # zero for a period inside it), the integrator advanced by that part only.
-        free = 0.0
-        if s[STEP_COUNT] >= self._window.first_step:
-            free = cpg.torque_free_fraction(elapsed, dt, self._window.start_s, self._window.end_s)
-        if free >= 1.0:
-            tau_swing_hip = 0.0
-        else:
-            s[INTEGRAL] += angle_error * dt * (1.0 - free)
-            tau_swing_hip = (1.0 - free) * gait.clip(
-                gait.hip_servo_torque(g, angle_error, zeta - swing_rate, s[INTEGRAL]), _HIP_LIMIT
-            )
-        s[GATE] = free
-        tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
-
-        a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
-        s[a_sw] = tau_swing_hip
-        s[a_st] = tau_stance_hip
-        # the swing knee's switches placed inside the period, along the state extrapolated over it
-        knee_start = (gamma, q[sw_i + KNEE], swing.thigh_angle)
-        knee_end = (cpg.advance_phase(self._cpg, gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
-                    swing.thigh_angle + dt * swing_rate)
-        s[a_sw + KNEE] = gait.clip(gait.swing_knee_torque_over(g, knee_start, knee_end), _KNEE_LIMIT)
-        s[a_st + KNEE] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
-        for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
-            foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
-            slope = ground.slope_at(leg.ankle_x)
-            s[a + ANKLE] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
+        # A touchdown predicted inside the coming period (the clearance extrapolated over it crosses the
+        # touchdown height) swaps the roles at its own time: the period's torques blend the present roles'
+        # and the new roles' by the part of the period each holds, so the swap's impulse is continuous in
+        # the state. The swap itself is recorded at the next update, from the crossing it then sees.
+        swap = None
+        if not touched and self._predicted_swap:
+            swap = self._predicted_touchdown(s, now, clearance, c_prev, advance, v[st_i + ANKLE])
+        if swap is not None:
+            new = s[:]
+            new[STANCE_RIGHT] = 0.0 if stance_right else 1.0
+            new[STEP_START] = now + swap * dt
+            new[LIFTOFF_ANGLE] = stance.thigh_angle + swap * dt * (pitch_rate + v[st_i])
+            new[STEP_COUNT] = s[STEP_COUNT] + 1.0
+            # the phase and the travel from T_n: negative now, so that after the period they are the part of
+            # it after T_n
+            new[GAMMA] = -swap * dt * cpg.phase_rate(self._cpg, v[sw_i + ANKLE])
+            new[TRAVEL] = -swap * dt * cpg.output(self._cpg, 0.0)
+            new[INTEGRAL] = 0.0
+            self._period_torques(new, q, v, now, not stance_right, swing, stance)
+        self._period_torques(s, q, v, now, stance_right, stance, swing)
+        if swap is not None:
+            for i in range(TAU, TAU + 6):
+                s[i] = swap * s[i] + (1.0 - swap) * new[i]
 
         # Fall detection and the end of the episode.
         if pz - ground.height(px) < self._fall_height:

@@ -179,6 +179,11 @@ class GaitParams(_Validated):
 
     # How zeta drives the swing (above): "anchored" or "integrated".
     swing_reading: str = "anchored"
+    # When the roles' torques swap at a touchdown: "predicted", at the instant inside the control period
+    # where the swing foot's clearance, extrapolated over the period, crosses the touchdown height (the
+    # period's torques blend the two roles' by the part of it each holds); "update", from the update that
+    # detects the crossing (up to one period late).
+    swap_timing: str = "predicted"
     # Integrated reading: a constant offset of the swing reference at the end of the half-cycle (rad).
     swing_offset_rad: float = 0.0
     # Swing hip: PID servo of the swing thigh's world angle to the CPG reference (angle, zeta).
@@ -243,12 +248,16 @@ class GaitParams(_Validated):
     }
 
     SWING_READINGS = ("anchored", "integrated")
+    SWAP_TIMINGS = ("predicted", "update")
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.swing_reading not in self.SWING_READINGS:
             raise ParameterError(f"GaitParams.swing_reading = {self.swing_reading!r} is not one of "
                                  f"{list(self.SWING_READINGS)}")
+        if self.swap_timing not in self.SWAP_TIMINGS:
+            raise ParameterError(f"GaitParams.swap_timing = {self.swap_timing!r} is not one of "
+                                 f"{list(self.SWAP_TIMINGS)}")
 
 
 @dataclass(frozen=True)

@@ -240,3 +240,17 @@ def test_floquet_command_writes_its_record(tmp_path):
     section = "\n".join(_floquet_sections({"floquet": {"without": {"markdown": floquet.markdown(record)}}}))
     assert "#### Floquet multipliers of the periodic orbit (no torque-free period)" in section
     assert f"{record['spectral_radius']:.4f}" in section and "floquet_without/floquet.png" in section
+
+
+def test_the_decay_check_stays_inside_the_linear_range():
+    """A growing mode gets a perturbation small enough that J^k delta stays below the plateau's top; a
+    decaying one, or a sweep without a plateau, the settings' size; never below the floor."""
+    from drake_biped.experiments.floquet import FloquetSettings, decay_size
+
+    settings = FloquetSettings(decay_size=1e-6, decay_floor=1e-12, decay_steps=5)
+    plateau = {"plateau": [1e-8, 3e-5]}
+    size = decay_size(settings, plateau, 4.0)
+    assert size == pytest.approx(3e-5 / 4.0**5) and size * 4.0**5 <= 3e-5 * (1 + 1e-12)
+    assert decay_size(settings, plateau, 0.5) == 1e-6
+    assert decay_size(settings, {"plateau": None}, 4.0) == 1e-6
+    assert decay_size(FloquetSettings(decay_floor=1e-9), plateau, 100.0) == 1e-9

@@ -68,6 +68,33 @@ def test_touchdown_records_are_the_logged_section_states(short_walk):
     assert max(backs) > 0.0  # the crossing is placed inside the control period, not on its grid
 
 
+def _swap_residuals(walk):
+    """Per touchdown after the first: the hip and knee torques held over the control period that contains
+    T_n, less the blend of the period before it (the old roles) and the period after it (the new roles) by
+    the part of the period before T_n; and the jump between those two periods."""
+    T = walk.trajectory
+    dt = _config().sim.control_period_s
+    a = T["actuation"][:, [0, 1, 3, 4]]
+    rows = []
+    for step in walk.steps[1:]:
+        i = int(np.flatnonzero(T["time"] >= step.touchdown_time_s - 1e-9)[0])
+        f = (step.touchdown_time_s - T["time"][i - 1]) / dt
+        rows.append((np.abs(a[i - 1] - (f * a[i - 2] + (1.0 - f) * a[i])).max(), np.abs(a[i] - a[i - 2]).max()))
+    return np.array(rows)
+
+
+def test_the_roles_swap_at_the_crossing_inside_the_control_period(short_walk):
+    """The roles' torques swap at T_n itself: the period that contains the crossing holds the old roles'
+    torques for the part of it before T_n and the new roles' after (within how much the new swing hip's
+    servo moves in one period), where swapping at the next update would hold the old roles' throughout."""
+    predicted = _swap_residuals(short_walk)
+    assert len(predicted) >= 2 and predicted[:, 1].min() > 20.0  # the swap moves the hips by > 20 N*m
+    assert (predicted[:, 0] / predicted[:, 1]).max() < 0.2
+    late = run_episode(_config().override({"gait.swap_timing": "update"}), record_trajectory=True)
+    late = _swap_residuals(late)
+    assert (late[:, 0] / late[:, 1]).max() > 0.5
+
+
 def test_episode_ends_at_the_update_that_walks_the_distance(short_walk):
     """The controller stops the run at the first control update with the centre of mass past the
     target: the distance overshoots by at most one control period of walking."""

@@ -42,14 +42,17 @@ class FloquetSettings:
     newton_iterations: int = 6
     plateau_tolerance: float = 0.05
     decay_steps: int = 5
+    # The perturbation of the decay check: at most decay_size, and small enough that J^k delta stays
+    # inside the sweep's plateau (the linear range) over the decay_steps, but not below decay_floor.
     decay_size: float = 1e-6
+    decay_floor: float = 1e-10
 
     def __post_init__(self) -> None:
         if not isinstance(self.settle_steps, int) or self.settle_steps < 1:
             raise ParameterError(f"settle_steps {self.settle_steps!r}: must be an integer >= 1")
         if len(self.epsilons) < 3 or any(not (math.isfinite(e) and e > 0) for e in self.epsilons):
             raise ParameterError(f"epsilons {self.epsilons!r}: need at least three positive sizes")
-        for name in ("newton_epsilon", "newton_tolerance", "plateau_tolerance", "decay_size"):
+        for name in ("newton_epsilon", "newton_tolerance", "plateau_tolerance", "decay_size", "decay_floor"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ParameterError(f"{name} {value!r}: must be a positive number")
@@ -60,7 +63,7 @@ class FloquetSettings:
         return {"settle_steps": self.settle_steps, "epsilons": list(self.epsilons),
                 "newton_epsilon": self.newton_epsilon, "newton_tolerance": self.newton_tolerance,
                 "newton_iterations": self.newton_iterations, "plateau_tolerance": self.plateau_tolerance,
-                "decay_steps": self.decay_steps, "decay_size": self.decay_size}
+                "decay_steps": self.decay_steps, "decay_size": self.decay_size, "decay_floor": self.decay_floor}
 
 
 def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
@@ -80,6 +83,16 @@ def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch
         return out
 
     return evaluate
+
+
+def decay_size(settings: FloquetSettings, plateau: dict[str, Any], radius: float) -> float:
+    """The decay check's perturbation: settings.decay_size, or less, so that a deviation growing by
+    `radius` per step stays below the top of the plateau (where the map is still linear) for
+    settings.decay_steps steps; never below settings.decay_floor."""
+    size = settings.decay_size
+    if plateau.get("plateau") and radius > 1.0:
+        size = min(size, plateau["plateau"][1] / radius**settings.decay_steps)
+    return max(size, settings.decay_floor)
 
 
 def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
@@ -115,7 +128,8 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     lead = next(k for k, t in enumerate(mult.trivial) if t is None)
     direction = mult.vectors[:, lead].real
     direction = direction / np.linalg.norm(direction)
-    delta = settings.decay_size * direction
+    size = decay_size(settings, chosen, mult.nontrivial_radius())
+    delta = size * direction
     predicted = fq.predicted_deviations(jac, delta, settings.decay_steps)
     iterated, pair = [], [z + delta, z]
     for _ in range(settings.decay_steps):
@@ -130,7 +144,7 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
         return [float(np.linalg.norm(r)) for r in rows]
 
     decay = {
-        "size": settings.decay_size,
+        "size": size,
         "direction": {n: float(v) for n, v in zip(names, direction)},
         "predicted": norms(predicted),
         "map_iterated": norms(iterated),
