@@ -114,10 +114,16 @@ class _Validated:
         if unknown:
             raise ParameterError(f"{where}: unknown parameter(s) {unknown}; known: {sorted(known)}")
         kwargs = {}
+        defaults = cls() if cls is EpisodeConfig else None
         for name, value in data.items():
             sub = _SECTIONS.get(name) if cls is EpisodeConfig else None
             if sub is not None:
                 inner = f"{where}.{name}" if where == cls.__name__ else f"{where}, section {name!r}"
+                # a section's missing fields are the default configuration's (the default gait's, not
+                # the class's), so that {"gait": {"hip_kd": 12}} is the default gait with one gain changed
+                default = getattr(defaults, name)
+                if default is not None and isinstance(value, Mapping):
+                    value = {**default.to_dict(), **value}
                 kwargs[name] = None if value is None else sub.from_dict(value, inner)
             else:
                 kwargs[name] = value

@@ -1,5 +1,6 @@
 """Bad input gets a clear error naming the value."""
 
+import json
 import math
 
 import pytest
@@ -48,6 +49,21 @@ def test_ground_height_and_slope():
 def test_config_round_trip():
     c = EpisodeConfig(window=TorqueFreeWindow(0.2, 0.5), seed=3)
     assert EpisodeConfig.from_dict(c.to_dict()) == c
+
+
+def test_a_partial_section_keeps_the_default_gait(tmp_path):
+    """A parameter file that names one gain changes that gain of the default gait; the rest of the section
+    is the default configuration's, not the bare class's (whose gait does not walk)."""
+    from drake_biped.params import GaitParams
+    from drake_biped.resources import load_gait
+
+    path = tmp_path / "one_gain.json"
+    path.write_text(json.dumps({"gait": {"hip_kd": 12.0}, "cpg": {"kappa": 2.0}}))
+    loaded = load_gait(path)
+    assert loaded == EpisodeConfig().override({"gait.hip_kd": 12.0, "cpg.kappa": 2.0})
+    assert loaded.gait.hip_kp == EpisodeConfig().gait.hip_kp != GaitParams().hip_kp
+    with pytest.raises(ParameterError, match="bogus"):
+        EpisodeConfig.from_dict({"gait": {"bogus": 1.0}})
 
 
 @pytest.mark.parametrize("argv, needle", [
