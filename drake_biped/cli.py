@@ -76,7 +76,7 @@ _count = _integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
-    p.add_argument("--params", help="a shipped gait by name (climbing, climbing_2deg, paper) or a JSON file of "
+    p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, paper) or a JSON file of "
                    "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
     p.add_argument("--distance", type=_number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
     p.add_argument("--max-time", type=_number("positive"),
@@ -501,10 +501,11 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--method", choices=["es", "cmaes"], default="es",
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
-    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest", "coast"], default="windows",
+    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest", "coast", "floquet"], default="windows",
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
                              "find a walker), 'policy' (the expected reward of the paper's start policy), "
-                             "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until touchdown)")
+                             "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until "
+                             "touchdown), 'floquet' (-ln of the period-1 orbit's spectral radius)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

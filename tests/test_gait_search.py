@@ -166,3 +166,30 @@ def test_coast_objective_scores_windows_that_run_to_touchdown(monkeypatch):
     value, _ = gait_search.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="coast")
     assert seen[1:] == list(gait_search.COAST_WINDOWS) and all(t2 >= 5.0 for _, t2 in seen[1:])
     assert value == pytest.approx((0.0 + 1.0 + 1.0 + 1.0) / 4 + 0.5 * 1.0)
+
+
+def test_floquet_objective_rewards_an_attracting_orbit(monkeypatch):
+    """(1 - rho) / (1 + rho): positive once the orbit attracts, below every converged orbit's for a Newton
+    that did not converge, and a walker whose orbit cannot be linearised between every walker and every
+    faller."""
+    from drake_biped.analysis.floquet import StepFailed
+    from drake_biped.experiments import floquet
+
+    monkeypatch.setattr(gait_search, "_walk", lambda config: {"walked": True, "cost_of_transport": 0.2,
+                                                              "distance_m": 6.0, "reward": 5.0})
+    orbits = iter([{"spectral_radius": 0.5, "fixed_point_residual": 1e-9},
+                   {"spectral_radius": 2.0, "fixed_point_residual": 1e-9},
+                   {"spectral_radius": 0.5, "fixed_point_residual": 1e-2}])
+    monkeypatch.setattr(floquet, "orbit_radius", lambda config: next(orbits))
+    config = EpisodeConfig(sim=SimulationParams(distance_m=6.0))
+    values = [gait_search.score(config, objective="floquet")[0] for _ in range(3)]
+    assert values == pytest.approx([1.0 / 3.0, -1.0 / 3.0, -1.0 / 3.0])
+    assert values[2] < 0.0 < values[0]
+
+    def falls(config):
+        raise StepFailed("a perturbed step fell")
+
+    monkeypatch.setattr(floquet, "orbit_radius", falls)
+    value, detail = gait_search.score(config, objective="floquet")
+    assert value == gait_search.FLOQUET_UNDEFINED and "fell" in detail["orbit"]["error"]
+    assert -9.0 + 8.0 * 0.999 < value < min(values)

@@ -42,8 +42,9 @@ class FloquetSettings:
     newton_iterations: int = 6
     plateau_tolerance: float = 0.05
     decay_steps: int = 5
-    # The perturbation of the decay check: at most decay_size, and small enough that J^k delta stays
-    # inside the sweep's plateau (the linear range) over the decay_steps, but not below decay_floor.
+    # The perturbation of the decay check (`decay_size()`): the largest that keeps J^k delta inside the
+    # sweep's plateau (the linear range) over the decay_steps; decay_size without a plateau; at least
+    # decay_floor.
     decay_size: float = 1e-6
     decay_floor: float = 1e-10
 
@@ -86,13 +87,31 @@ def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch
 
 
 def decay_size(settings: FloquetSettings, plateau: dict[str, Any], radius: float) -> float:
-    """The decay check's perturbation: settings.decay_size, or less, so that a deviation growing by
-    `radius` per step stays below the top of the plateau (where the map is still linear) for
-    settings.decay_steps steps; never below settings.decay_floor."""
+    """The decay check's perturbation: the largest for which the map is still linear over the check, so
+    that the deviations stay above the map's rounding for as long as they can: the top of the plateau,
+    divided by radius**decay_steps when the mode grows (so the deviation stays below it for
+    settings.decay_steps steps); settings.decay_size without a plateau; never below settings.decay_floor."""
     size = settings.decay_size
-    if plateau.get("plateau") and radius > 1.0:
-        size = min(size, plateau["plateau"][1] / radius**settings.decay_steps)
+    if plateau.get("plateau"):
+        size = plateau["plateau"][1] / max(1.0, radius) ** settings.decay_steps
     return max(size, settings.decay_floor)
+
+
+def orbit_radius(config: EpisodeConfig, settle_steps: int = 8, epsilon: float = 1e-6,
+                 iterations: int = 4) -> dict[str, Any]:
+    """The spectral radius of `config`'s period-1 orbit in one process, for searches (no Dask, no sweep):
+    Newton from the section after `settle_steps` touchdowns, then one central-difference Jacobian at
+    `epsilon` at the fixed point. Raises ParameterError when the gait falls before its section, StepFailed
+    when a perturbed step falls."""
+    from drake_biped.analysis.step_map import SectionMap
+
+    section_map = SectionMap(config)
+    z0, template = section_map.start(settle_steps)
+    evaluate = fq.serial(lambda z: section_map.step(z, template))
+    fixed = fq.newton_fixed_point(evaluate, z0, epsilon, tolerance=1e-9, max_iterations=iterations)
+    jac = fq.difference_jacobian(evaluate, fixed.state, epsilon)
+    mult = fq.multipliers(jac, section_map.section_normal())
+    return {"spectral_radius": mult.nontrivial_radius(), "fixed_point_residual": fixed.residual}
 
 
 def analyse(settings: FloquetSettings, client) -> dict[str, Any]:

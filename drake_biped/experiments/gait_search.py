@@ -15,6 +15,10 @@ walks, by the objective:
   lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau);
 - "nearest": minus the CPG's distance from Table III (`distance_from_table_iii`), to find the walker whose
   CPG is nearest the paper's (with the "near_paper" mutations);
+- "floquet": (1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit
+  (`floquet.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map):
+  positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3;
+  FLOQUET_UNDEFINED (-1) when a perturbed step falls;
 - "policy": what the paper's learner climbs from its start: the expected reward of the policy
   N((0.5, 0.5), 0.04 I) over POLICY_DRAWS fixed draws, relative to no window (a draw with t2 <= t1 is no
   window and takes its reward), plus half the largest gain of a single drawn window.
@@ -92,9 +96,12 @@ NEAR_PAPER_MUTATIONS = {
     **PAPER_MUTATIONS,
 }
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "nearest", "coast")
+OBJECTIVES = ("windows", "walk", "policy", "nearest", "coast", "floquet")
 # Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
 COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
+# The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
+# faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
+FLOQUET_UNDEFINED = -1.0
 
 
 def distance_from_table_iii(cpg) -> float:
@@ -142,6 +149,24 @@ def _walk(config: EpisodeConfig) -> dict[str, Any]:
     }
 
 
+def _orbit_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """(1 - rho) / (1 + rho) of the period-1 orbit's spectral radius rho (in (-1, 1], positive once the orbit
+    attracts), mapped into (-1, 0) when Newton left a residual above 1e-3, and FLOQUET_UNDEFINED when the
+    orbit cannot be linearised (a perturbed step falls)."""
+    from drake_biped.analysis.floquet import StepFailed
+    from drake_biped.experiments.floquet import orbit_radius
+
+    try:
+        orbit = orbit_radius(config)
+    except (StepFailed, ParameterError) as exc:
+        return FLOQUET_UNDEFINED, {"baseline": base, "windows": [], "orbit": {"error": str(exc)}}
+    rho = orbit["spectral_radius"]
+    value = (1.0 - rho) / (1.0 + rho)
+    if orbit["fixed_point_residual"] > 1e-3:
+        value = 0.5 * (value - 1.0)
+    return value, {"baseline": base, "windows": [], "orbit": orbit}
+
+
 def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows") -> tuple[float, dict[str, Any]]:
     """The search objective (module docstring) and what it measured."""
     base = _walk(config.replace(window=TorqueFreeWindow()))
@@ -152,6 +177,8 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         return 0.0, {"baseline": base, "windows": []}
     if objective == "nearest":
         return -distance_from_table_iii(config.cpg), {"baseline": base, "windows": []}
+    if objective == "floquet":
+        return _orbit_score(config, base)
     if objective == "policy":
         windows = policy_draws()
     elif objective == "coast":
