@@ -71,6 +71,7 @@ class Profile:
     expected_minutes: float  # on 2 cores
     compare: tuple[int, int] = (1, 6)  # trials, episodes per learner in the side-by-side comparison
     floquet_epsilons: tuple[float, ...] = ()  # the Floquet sweep's perturbations (empty: its default)
+    floquet_newton_iterations: int = 6  # Newton's iterations towards each orbit (FloquetSettings' default)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -286,7 +287,9 @@ class Reproduction:
             for name, (t1, t2) in windows.items():
                 config = self.level.replace(window=TorqueFreeWindow(t1, t2))
                 eps = {"epsilons": tuple(self.profile.floquet_epsilons)} if self.profile.floquet_epsilons else {}
-                record = floquet.run(floquet.FloquetSettings(config, **eps), folder / name, self._client)
+                settings = floquet.FloquetSettings(config, newton_iterations=self.profile.floquet_newton_iterations,
+                                                   **eps)
+                record = floquet.run(settings, folder / name, self._client)
                 out[name] = {"window": [t1, t2], **{k: record[k] for k in (
                     "spectral_radius", "converged_epsilon", "fixed_point_residual", "multipliers", "plateau",
                     "sampling_phase_drift")}, "decay": {k: record["decay"][k] for k in (
