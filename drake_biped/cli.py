@@ -494,18 +494,22 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
     search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
     search.add_argument("--sigma", type=_number("positive"), default=0.1, help="mutation scale (default 0.1)")
-    search.add_argument("--mutations", choices=["default", "paper", "near_paper"], default="default",
+    search.add_argument("--mutations", choices=["default", "paper", "near_paper", "coast"], default="default",
                         help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
-                             "the paper does not print: the CPG and the initiation held) or 'near_paper' (those "
-                             "and u_a, u_r, kappa)")
+                             "the paper does not print: the CPG and the initiation held), 'near_paper' (those "
+                             "and u_a, u_r, kappa) or 'coast' (default, the knee's hold torque, the torso's "
+                             "gains and the stance knee)")
     search.add_argument("--method", choices=["es", "cmaes"], default="es",
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
-    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest", "coast", "floquet"], default="windows",
+    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest", "coast", "floquet", "landscape"],
+                        default="windows",
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
                              "find a walker), 'policy' (the expected reward of the paper's start policy), "
                              "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until "
-                             "touchdown), 'floquet' (-ln of the period-1 orbit's spectral radius)")
+                             "touchdown), 'floquet' ((1 - rho)/(1 + rho) of the period-1 orbit), 'landscape' "
+                             "(the paper's start policy's expected gain on a coarse window map, half the best "
+                             "mean's, less 0.25 a failed 20 N push)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

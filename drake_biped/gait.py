@@ -42,15 +42,15 @@ def swing_knee_torque(gait: GaitParams, gamma: float, knee_angle: float, thigh_a
 
     Extend once the CPG phase has passed knee_extend_phase and the thigh is ahead of
     knee_extend_thigh_rad (the clearance guard); before that, extend whenever the knee is past
-    knee_flex_max_rad, flex while the phase is below knee_flex_until_phase, and otherwise apply no
-    torque (the knee swings passively)."""
+    knee_flex_max_rad, flex while the phase is below knee_flex_until_phase, and otherwise apply
+    knee_hold_torque (0 by default: the knee swings passively)."""
     if gamma >= gait.knee_extend_phase and thigh_angle >= gait.knee_extend_thigh_rad:
         return -gait.knee_extend_torque
     if knee_angle >= gait.knee_flex_max_rad:
         return -gait.knee_extend_torque
     if gamma < gait.knee_flex_until_phase:
         return gait.knee_flex_torque
-    return 0.0
+    return gait.knee_hold_torque
 
 
 def swing_knee_torque_over(gait: GaitParams, start: tuple[float, float, float], end: tuple[float, float, float],

@@ -218,6 +218,10 @@ class GaitParams(_Validated):
     # Flexing stops once the CPG phase passes this (rad); from there until extension the knee is
     # passive (zero torque), swinging as in ballistic walking. pi: flex until extension.
     knee_flex_until_phase: float = math.pi
+    # The swing knee's torque in that passive middle (N*m, positive flexes): 0 leaves the knee free; a
+    # small flexing torque keeps the shank from taking the thigh's momentum while the thigh coasts, so
+    # the foot stays up until the extension (which still needs the phase and the thigh guard).
+    knee_hold_torque: float = 0.0
     stance_knee_torque: float = 17.7  # N*m
     # Ankles: PD keeping each foot parallel to the local ground.
     ankle_kp: float = 20.0  # N*m/rad
@@ -243,6 +247,7 @@ class GaitParams(_Validated):
         "knee_flex_max_rad": (0.0, 2.4),
         "knee_extend_thigh_rad": (-1.0, 1.0),
         "knee_flex_until_phase": (0.0, math.pi),
+        "knee_hold_torque": (-30.0, 30.0),
         "stance_knee_torque": (0.0, 30.0),
         "ankle_kp": (0.0, 500.0),
         "ankle_kd": (0.0, 50.0),

@@ -1,5 +1,7 @@
 """The leg laws: knee bang-bang with its clearance guard, touchdown, torso and ankle signs."""
 
+import dataclasses
+
 import pytest
 
 from drake_biped import gait
@@ -26,6 +28,9 @@ def test_swing_knee_passive_middle():
     assert gait.swing_knee_torque(g, 1.5, 0.8, -0.1) == 0.0  # passive
     assert gait.swing_knee_torque(g, 1.5, 1.3, -0.1) == -7.0  # limit guard
     assert gait.swing_knee_torque(g, 2.6, 0.8, 0.3) == -7.0  # extension
+    held = dataclasses.replace(g, knee_hold_torque=1.5)  # the passive middle held flexed, nothing else
+    assert [gait.swing_knee_torque(held, *x) for x in ((0.5, 0.3, -0.3), (1.5, 0.8, -0.1), (1.5, 1.3, -0.1),
+                                                      (2.6, 0.8, 0.3))] == [5.0, 1.5, -7.0, -7.0]
 
 
 def test_swing_knee_switch_inside_a_period_blends_by_the_time_each_branch_holds():

@@ -193,3 +193,27 @@ def test_floquet_objective_rewards_an_attracting_orbit(monkeypatch):
     value, detail = gait_search.score(config, objective="floquet")
     assert value == gait_search.FLOQUET_UNDEFINED and "fell" in detail["orbit"]["error"]
     assert -9.0 + 8.0 * 0.999 < value < min(values)
+
+
+def test_landscape_objective_is_the_start_policys_gain_and_counts_failed_pushes(monkeypatch):
+    """Every window halves the cost: the paper's start policy N((0.5, 0.5), 0.04 I) draws a window (t2 > t1)
+    half the time, so it expects +50 %; a policy mean far above the diagonal draws one always (+100 %); a
+    gait that falls to the backward push loses PUSH_PENALTY."""
+    seen = []
+
+    def fake_walk(config):
+        push = config.push.force_n if config.push is not None else 0.0
+        seen.append((config.window.start_s, config.window.end_s, push))
+        walked = push >= 0.0
+        cmt = 0.1 if config.window.active else 0.2
+        return {"walked": walked, "cost_of_transport": cmt, "distance_m": 6.0, "reward": 1.0 / cmt}
+
+    monkeypatch.setattr(gait_search, "_walk", fake_walk)
+    value, detail = gait_search.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="landscape")
+    windows = [(t1, t2) for t1, t2, push in seen if push == 0.0 and t2 > t1]
+    assert windows == list(gait_search.LANDSCAPE_WINDOWS) and all(0 <= t1 <= 0.8 and t2 <= 1.2 for t1, t2 in windows)
+    assert sorted(push for *_, push in seen if push) == [-gait_search.PUSH_FORCE_N, gait_search.PUSH_FORCE_N]
+    assert detail["landscape"]["start_gain"] == pytest.approx(0.5, abs=0.05)
+    assert detail["landscape"]["best_gain"] == pytest.approx(1.0, abs=0.02)
+    assert value == pytest.approx(detail["landscape"]["start_gain"] + 0.5 * detail["landscape"]["best_gain"]
+                                  - gait_search.PUSH_PENALTY)

@@ -21,12 +21,17 @@ walks, by the objective:
   FLOQUET_UNDEFINED (-1) when a perturbed step falls;
 - "policy": what the paper's learner climbs from its start: the expected reward of the policy
   N((0.5, 0.5), 0.04 I) over POLICY_DRAWS fixed draws, relative to no window (a draw with t2 <= t1 is no
-  window and takes its reward), plus half the largest gain of a single drawn window.
+  window and takes its reward), plus half the largest gain of a single drawn window;
+- "landscape": the same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s)
+  through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the
+  best policy mean's gain, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a
+  window) the gait does not walk through.
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
 CPG and the printed initiation held at what the start configuration has)
-or "near_paper" (those and the CPG's u_a, u_r, kappa).
+or "near_paper" (those and the CPG's u_a, u_r, kappa) or "coast" (MUTATIONS, the knee's hold torque, the
+torso's gains and the stance knee).
 Every generation is appended to `search.jsonl`; a rerun resumes from its last line. The children of a
 generation are scored in parallel on Dask (`executor`).
 """
@@ -95,8 +100,18 @@ NEAR_PAPER_MUTATIONS = {
     ("cpg", "kappa"): ("log", 0.1, 0.05, 9.0),
     **PAPER_MUTATIONS,
 }
-MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "nearest", "coast", "floquet")
+# For a swing that coasts to touchdown: MUTATIONS, the knee's hold torque in its passive middle (which keeps
+# the shank from taking the coasting thigh's momentum), the torso's gains and the stance knee.
+COAST_MUTATIONS = {
+    **MUTATIONS,
+    ("gait", "knee_hold_torque"): ("add", 0.3, -2.0, 10.0),
+    ("gait", "torso_kp"): ("log", 0.1, 20.0, 5000.0),
+    ("gait", "torso_kd"): ("log", 0.1, 2.0, 500.0),
+    ("gait", "stance_knee_torque"): ("log", 0.1, 1.0, 30.0),
+}
+MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
+                 "coast": COAST_MUTATIONS}
+OBJECTIVES = ("windows", "walk", "policy", "nearest", "coast", "floquet", "landscape")
 # Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
 COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
@@ -112,6 +127,12 @@ def distance_from_table_iii(cpg) -> float:
     return sum(abs(math.log(getattr(cpg, k) / TABLE_III[k])) for k in ("u_a", "u_r", "kappa"))
 # The paper's learner starts at (0.5, 0.5) with variance 0.04 (Table II): fixed draws of that policy.
 POLICY_START, POLICY_VARIANCE, POLICY_DRAWS = (0.5, 0.5), 0.04, 12
+
+
+# The "landscape" objective's window map (t2 > t1) and push test.
+LANDSCAPE_WINDOWS = tuple((t1, t2) for t1 in (0.0, 0.2, 0.4, 0.6, 0.8) for t2 in (0.2, 0.4, 0.6, 0.8, 1.0, 1.2)
+                          if t2 > t1)
+PUSH_FORCE_N, PUSH_PENALTY = 20.0, 0.25
 
 
 def policy_draws(count: int = POLICY_DRAWS, seed: int = 0) -> list[tuple[float, float]]:
@@ -167,6 +188,33 @@ def _orbit_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, di
     return value, {"baseline": base, "windows": [], "orbit": orbit}
 
 
+def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "landscape" objective (module docstring) and what it measured."""
+    import numpy as np
+
+    from drake_biped.analysis.landscape import WindowRewards, landscape
+    from drake_biped.params import Push
+
+    rows = []
+    for t1, t2 in LANDSCAPE_WINDOWS:
+        row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
+        row["window"] = [t1, t2]
+        rows.append(row)
+    rewards = WindowRewards(np.array([r["window"] for r in rows]), np.array([r["reward"] for r in rows]),
+                            base["reward"])
+    land = landscape(rewards, [POLICY_VARIANCE], t2_range=(0.0, 1.2), step=0.05, samples=1000,
+                     starts=(POLICY_START,))["variances"][0]
+    start_gain, best_gain = land["starts"][0]["gain"], land["best_gain"]
+    pushes = []
+    for sign in (1.0, -1.0):
+        row = _walk(config.replace(window=TorqueFreeWindow(), push=Push(sign * PUSH_FORCE_N)))
+        row["push_n"] = sign * PUSH_FORCE_N
+        pushes.append(row)
+    value = start_gain + 0.5 * max(0.0, best_gain) - PUSH_PENALTY * sum(not p["walked"] for p in pushes)
+    return value, {"baseline": base, "windows": rows, "pushes": pushes,
+                   "landscape": {"start_gain": start_gain, "best_gain": best_gain, "best_mean": land["best_mean"]}}
+
+
 def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows") -> tuple[float, dict[str, Any]]:
     """The search objective (module docstring) and what it measured."""
     base = _walk(config.replace(window=TorqueFreeWindow()))
@@ -179,6 +227,8 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         return -distance_from_table_iii(config.cpg), {"baseline": base, "windows": []}
     if objective == "floquet":
         return _orbit_score(config, base)
+    if objective == "landscape":
+        return _landscape_score(config, base)
     if objective == "policy":
         windows = policy_draws()
     elif objective == "coast":
