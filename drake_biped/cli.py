@@ -76,8 +76,8 @@ _count = _integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
-    p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, paper) or a JSON file of "
-                   "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
+    p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, coasting, paper) "
+                   "or a JSON file of EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
     p.add_argument("--distance", type=_number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
     p.add_argument("--max-time", type=_number("positive"),
                    help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
@@ -509,7 +509,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until "
                              "touchdown), 'floquet' ((1 - rho)/(1 + rho) of the period-1 orbit), 'landscape' "
                              "(the paper's start policy's expected gain on a coarse window map, half the best "
-                             "mean's, less 0.25 a failed 20 N push)")
+                             "mean's up to 0.2, less 0.25 a failed 20 N push)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

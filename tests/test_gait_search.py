@@ -215,5 +215,5 @@ def test_landscape_objective_is_the_start_policys_gain_and_counts_failed_pushes(
     assert sorted(push for *_, push in seen if push) == [-gait_search.PUSH_FORCE_N, gait_search.PUSH_FORCE_N]
     assert detail["landscape"]["start_gain"] == pytest.approx(0.5, abs=0.05)
     assert detail["landscape"]["best_gain"] == pytest.approx(1.0, abs=0.02)
-    assert value == pytest.approx(detail["landscape"]["start_gain"] + 0.5 * detail["landscape"]["best_gain"]
+    assert value == pytest.approx(detail["landscape"]["start_gain"] + 0.5 * gait_search.BEST_GAIN_CAP
                                   - gait_search.PUSH_PENALTY)

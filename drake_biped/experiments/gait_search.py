@@ -24,7 +24,7 @@ walks, by the objective:
   window and takes its reward), plus half the largest gain of a single drawn window;
 - "landscape": the same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s)
   through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the
-  best policy mean's gain, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a
+  best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a
   window) the gait does not walk through.
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
@@ -133,6 +133,9 @@ POLICY_START, POLICY_VARIANCE, POLICY_DRAWS = (0.5, 0.5), 0.04, 12
 LANDSCAPE_WINDOWS = tuple((t1, t2) for t1 in (0.0, 0.2, 0.4, 0.6, 0.8) for t2 in (0.2, 0.4, 0.6, 0.8, 1.0, 1.2)
                           if t2 > t1)
 PUSH_FORCE_N, PUSH_PENALTY = 20.0, 0.25
+# The best policy mean's gain counts up to this (the paper's learner needs it large enough to be worth finding,
+# and then needs the start's gain above all).
+BEST_GAIN_CAP = 0.2
 
 
 def policy_draws(count: int = POLICY_DRAWS, seed: int = 0) -> list[tuple[float, float]]:
@@ -210,7 +213,7 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
         row = _walk(config.replace(window=TorqueFreeWindow(), push=Push(sign * PUSH_FORCE_N)))
         row["push_n"] = sign * PUSH_FORCE_N
         pushes.append(row)
-    value = start_gain + 0.5 * max(0.0, best_gain) - PUSH_PENALTY * sum(not p["walked"] for p in pushes)
+    value = start_gain + 0.5 * min(max(0.0, best_gain), BEST_GAIN_CAP) - PUSH_PENALTY * sum(not p["walked"] for p in pushes)
     return value, {"baseline": base, "windows": rows, "pushes": pushes,
                    "landscape": {"start_gain": start_gain, "best_gain": best_gain, "best_mean": land["best_mean"]}}
 
