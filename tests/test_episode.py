@@ -128,14 +128,15 @@ def test_torque_free_window_saves_energy_without_a_fall():
 def test_the_coasting_gait_walks_with_the_hip_off_until_the_foot_lands():
     """The shipped gait `coasting`'s defining property: its swing hip off from 0.3 s after each touchdown
     until the next (t2 beyond any step), it walks 10 m and saves (measured: C_mt 0.335 -> 0.276, -18 %);
-    every step of the default gait is a fall that way (within 1.5 m)."""
+    the default gait falls that way (at 1.5 m)."""
     from drake_biped.resources import load_gait
 
     coasting = load_gait("coasting")
     base = run_episode(coasting)
     coast = run_episode(coasting.replace(window=TorqueFreeWindow(0.3, 5.0)))
     assert not base.fell and not coast.fell and coast.distance_m >= 10.0
-    assert coast.step_period_s < 1.0  # every step ended inside the window: the swing coasted to touchdown
+    steps = np.diff([s.touchdown_time_s for s in coast.steps])
+    assert np.all(steps > 0.3)  # every step ended inside the window: the swing coasted to touchdown
     assert coast.cost_of_transport < 0.9 * base.cost_of_transport
     assert run_episode(EpisodeConfig(window=TorqueFreeWindow(0.3, 5.0))).fell
 

@@ -24,8 +24,8 @@ walks, by the objective:
   window and takes its reward), plus half the largest gain of a single drawn window;
 - "landscape": the same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s)
   through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the
-  best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a
-  window) the gait does not walk through.
+  best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes
+  (stability's, without a window) the gait does not walk through.
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
@@ -173,6 +173,17 @@ def _walk(config: EpisodeConfig) -> dict[str, Any]:
     }
 
 
+def _window_rows(config: EpisodeConfig, windows, base: dict[str, Any]) -> list[dict[str, Any]]:
+    """`_walk` of `config` with each window (t1, t2), its row tagged with the window; t2 <= t1 is no window
+    and takes the baseline's row."""
+    rows = []
+    for t1, t2 in windows:
+        row = dict(base) if t2 <= t1 else _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
+        row["window"] = [t1, t2]
+        rows.append(row)
+    return rows
+
+
 def _orbit_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
     """(1 - rho) / (1 + rho) of the period-1 orbit's spectral radius rho (in (-1, 1], positive once the orbit
     attracts), mapped into (-1, 0) when Newton left a residual above 1e-3, and FLOQUET_UNDEFINED when the
@@ -198,11 +209,7 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     from drake_biped.analysis.landscape import WindowRewards, landscape
     from drake_biped.params import Push
 
-    rows = []
-    for t1, t2 in LANDSCAPE_WINDOWS:
-        row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
-        row["window"] = [t1, t2]
-        rows.append(row)
+    rows = _window_rows(config, LANDSCAPE_WINDOWS, base)
     rewards = WindowRewards(np.array([r["window"] for r in rows]), np.array([r["reward"] for r in rows]),
                             base["reward"])
     land = landscape(rewards, [POLICY_VARIANCE], t2_range=(0.0, 1.2), step=0.05, samples=1000,
@@ -213,7 +220,8 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
         row = _walk(config.replace(window=TorqueFreeWindow(), push=Push(sign * PUSH_FORCE_N)))
         row["push_n"] = sign * PUSH_FORCE_N
         pushes.append(row)
-    value = start_gain + 0.5 * min(max(0.0, best_gain), BEST_GAIN_CAP) - PUSH_PENALTY * sum(not p["walked"] for p in pushes)
+    failed = sum(not p["walked"] for p in pushes)
+    value = start_gain + 0.5 * min(max(0.0, best_gain), BEST_GAIN_CAP) - PUSH_PENALTY * failed
     return value, {"baseline": base, "windows": rows, "pushes": pushes,
                    "landscape": {"start_gain": start_gain, "best_gain": best_gain, "best_mean": land["best_mean"]}}
 
@@ -236,14 +244,7 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         windows = policy_draws()
     elif objective == "coast":
         windows = COAST_WINDOWS
-    rows = []
-    for t1, t2 in windows:
-        if t2 <= t1:
-            row = dict(base)
-        else:
-            row = _walk(config.replace(window=TorqueFreeWindow(t1, t2)))
-        row["window"] = [t1, t2]
-        rows.append(row)
+    rows = _window_rows(config, windows, base)
     if objective in ("policy", "coast"):
         gains = [r["reward"] / base["reward"] - 1.0 for r in rows]
         value = sum(gains) / len(gains) + 0.5 * max(0.0, max(gains))
