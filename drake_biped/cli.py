@@ -172,7 +172,7 @@ def cmd_gait_search(args: argparse.Namespace) -> int:
     settings = gait_search.GaitSearchSettings(
         config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
         distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
-        objective=args.objective)
+        objective=args.objective, policy_draws=args.policy_draws)
     search = gait_search.run_cmaes if args.method == "cmaes" else gait_search.run
     with _client(args) as client:
         result = search(settings, Path(args.out), client)
@@ -502,14 +502,18 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--method", choices=["es", "cmaes"], default="es",
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
-    search.add_argument("--objective", choices=["windows", "walk", "policy", "nearest", "coast", "floquet", "landscape"],
-                        default="windows",
+    search.add_argument("--objective", default="windows",
+                        choices=["windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape"],
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
-                             "find a walker), 'policy' (the expected reward of the paper's start policy), "
+                             "find a walker), 'policy' (the expected reward of the paper's start policy, plus "
+                             "half its best draw's), 'expected' (that expected reward alone), "
                              "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until "
                              "touchdown), 'floquet' ((1 - rho)/(1 + rho) of the period-1 orbit), 'landscape' "
                              "(the paper's start policy's expected gain on a coarse window map, half the best "
                              "mean's up to 0.2, less 0.25 a failed 20 N push)")
+    search.add_argument("--policy-draws", type=_count, default=12,
+                        help="draws of the paper's start policy the 'policy' and 'expected' objectives walk "
+                             "(default 12; a draw with t2 <= t1 is no window and costs no episode)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 

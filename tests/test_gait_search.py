@@ -106,6 +106,14 @@ def test_policy_objective_is_the_expected_gain_of_the_draws(monkeypatch):
     assert 0 < windowed < len(draws)
     assert value == pytest.approx(windowed / len(draws) + 0.5)
     assert [r["window"] for r in detail["windows"]] == [list(d) for d in draws]
+    more = policy_draws(32)
+    assert more[:len(draws)] == draws  # more draws extend the same fixed sequence
+    value, detail = gait_search.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="policy",
+                                      draws=32)
+    assert [r["window"] for r in detail["windows"]] == [list(d) for d in more]
+    assert value == pytest.approx(sum(1 for t1, t2 in more if t2 > t1) / 32 + 0.5)
+    value, _ = gait_search.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="expected", draws=32)
+    assert value == pytest.approx(sum(1 for t1, t2 in more if t2 > t1) / 32)  # the mean gain alone
 
 
 def test_unknown_search_settings_are_refused():
@@ -113,6 +121,8 @@ def test_unknown_search_settings_are_refused():
         GaitSearchSettings(mutations="everything")
     with pytest.raises(ParameterError, match="objective"):
         GaitSearchSettings(objective="speed")
+    with pytest.raises(ParameterError, match="policy_draws"):
+        GaitSearchSettings(policy_draws=0)
 
 
 def test_cmaes_search_resumes_to_the_uninterrupted_result(tmp_path, client):

@@ -20,8 +20,10 @@ walks, by the objective:
   positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3;
   FLOQUET_UNDEFINED (-1) when a perturbed step falls;
 - "policy": what the paper's learner climbs from its start: the expected reward of the policy
-  N((0.5, 0.5), 0.04 I) over POLICY_DRAWS fixed draws, relative to no window (a draw with t2 <= t1 is no
+  N((0.5, 0.5), 0.04 I) over POLICY_DRAWS (or `policy_draws`) fixed draws, relative to no window (a draw with t2 <= t1 is no
   window and takes its reward), plus half the largest gain of a single drawn window;
+- "expected": the expected reward's gain alone, over the same draws (one drawn window that saves much cannot
+  carry a gait whose other draws fall);
 - "landscape": the same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s)
   through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the
   best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes
@@ -111,7 +113,7 @@ COAST_MUTATIONS = {
 }
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
                  "coast": COAST_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "nearest", "coast", "floquet", "landscape")
+OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape")
 # Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
 COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
@@ -226,8 +228,10 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                    "landscape": {"start_gain": start_gain, "best_gain": best_gain, "best_mean": land["best_mean"]}}
 
 
-def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows") -> tuple[float, dict[str, Any]]:
-    """The search objective (module docstring) and what it measured."""
+def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows",
+          draws: int = POLICY_DRAWS) -> tuple[float, dict[str, Any]]:
+    """The search objective (module docstring) and what it measured; `draws`: how many draws of the start
+    policy the "policy" and "expected" objectives walk."""
     base = _walk(config.replace(window=TorqueFreeWindow()))
     if not base["walked"]:
         return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
@@ -240,14 +244,14 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         return _orbit_score(config, base)
     if objective == "landscape":
         return _landscape_score(config, base)
-    if objective == "policy":
-        windows = policy_draws()
+    if objective in ("policy", "expected"):
+        windows = policy_draws(draws)
     elif objective == "coast":
         windows = COAST_WINDOWS
     rows = _window_rows(config, windows, base)
-    if objective in ("policy", "coast"):
+    if objective in ("policy", "expected", "coast"):
         gains = [r["reward"] / base["reward"] - 1.0 for r in rows]
-        value = sum(gains) / len(gains) + 0.5 * max(0.0, max(gains))
+        value = sum(gains) / len(gains) + (0.0 if objective == "expected" else 0.5 * max(0.0, max(gains)))
         return value, {"baseline": base, "windows": rows}
     savings = [1.0 - r["cost_of_transport"] / base["cost_of_transport"] for r in rows if r["walked"]]
     value = (max(savings) if savings else -0.3) + 0.03 * len(savings)
@@ -255,9 +259,9 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
 
 
 def _child(args) -> tuple[dict, float, dict]:
-    parent_dict, seed, sigma, windows, mutations, objective = args
+    parent_dict, seed, sigma, windows, mutations, objective, draws = args
     child = mutate(EpisodeConfig.from_dict(parent_dict), random.Random(seed), sigma, MUTATION_SETS[mutations])
-    value, detail = score(child, windows, objective)
+    value, detail = score(child, windows, objective, draws)
     return child.to_dict(), value, detail
 
 
@@ -274,15 +278,18 @@ class GaitSearchSettings:
     windows: tuple[tuple[float, float], ...] = ACCEPTANCE_WINDOWS
     mutations: str = "default"
     objective: str = "windows"
+    policy_draws: int = POLICY_DRAWS
 
     def __post_init__(self) -> None:
         if self.mutations not in MUTATION_SETS:
             raise ParameterError(f"mutations {self.mutations!r} is not one of {sorted(MUTATION_SETS)}")
         if self.objective not in OBJECTIVES:
             raise ParameterError(f"objective {self.objective!r} is not one of {list(OBJECTIVES)}")
-        if self.generations < 1 or self.offspring < 1 or not self.sigma > 0 or not self.distance_m > 0:
+        if self.generations < 1 or self.offspring < 1 or self.policy_draws < 1 or not self.sigma > 0 \
+                or not self.distance_m > 0:
             raise ParameterError(
-                f"generations ({self.generations!r}) and offspring ({self.offspring!r}) must be >= 1, "
+                f"generations ({self.generations!r}), offspring ({self.offspring!r}) and policy_draws "
+                f"({self.policy_draws!r}) must be >= 1, "
                 f"sigma ({self.sigma!r}) and distance_m ({self.distance_m!r}) > 0"
             )
 
@@ -296,10 +303,10 @@ def _search_start(settings: GaitSearchSettings) -> EpisodeConfig:
 
 def _score_start(c, settings: GaitSearchSettings, start: EpisodeConfig, windows, log: Path, **extra) -> float:
     """Generation 0: score the start on the cluster and log it with the search's settings; its score."""
-    value, detail = c.submit(score, start, windows, settings.objective, pure=False).result()
+    value, detail = c.submit(score, start, windows, settings.objective, settings.policy_draws, pure=False).result()
     _append(log, {"generation": 0, "parent": start.to_dict(), "parent_score": value, "detail": detail,
                   "seed": settings.seed, "sigma": settings.sigma, "mutations": settings.mutations,
-                  "objective": settings.objective, **extra, "versions": versions()})
+                  "objective": settings.objective, "policy_draws": settings.policy_draws, **extra, "versions": versions()})
     return value
 
 
@@ -344,7 +351,7 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
             parent, parent_score, first = start.to_dict(), _score_start(c, settings, start, windows, log), 1
         for gen, note in _generations(settings, first, "search", progress):
             jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows, settings.mutations,
-                     settings.objective) for k in range(settings.offspring)]
+                     settings.objective, settings.policy_draws) for k in range(settings.offspring)]
             children = map_ordered(c, _child, jobs)
             best_dict, best_score, best_detail = max(children, key=lambda ch: ch[1])
             if best_score >= parent_score:
@@ -379,8 +386,8 @@ def decode(start: EpisodeConfig, mutations, x, sigma: float = 0.1) -> EpisodeCon
 
 
 def _scored(args) -> tuple[float, dict]:
-    config_dict, windows, objective = args
-    return score(EpisodeConfig.from_dict(config_dict), windows, objective)
+    config_dict, windows, objective, draws = args
+    return score(EpisodeConfig.from_dict(config_dict), windows, objective, draws)
 
 
 def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
@@ -419,7 +426,8 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
         for gen, note in _generations(settings, first, "cma-es", progress):
             xs = ask(gen)
             configs = [decode(start, mutations, x, settings.sigma).to_dict() for x in xs]
-            results = map_ordered(c, _scored, [(cfg, windows, settings.objective) for cfg in configs])
+            results = map_ordered(c, _scored, [(cfg, windows, settings.objective, settings.policy_draws)
+                                                  for cfg in configs])
             scores = [r[0] for r in results]
             es.tell(xs, [-v for v in scores])
             k = int(np.argmax(scores))
