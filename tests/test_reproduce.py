@@ -92,7 +92,7 @@ SMOKE = Profile("smoke", distance_m=5.0, grid_points=1, grid_initiation_points=1
 SECTIONS = ("## The walk", "## Grid search, Table IV", "## Table III as printed", "## Torque-free windows",
             "## Experiment 1", "## Learners side by side",
             "### Table V", "### Exploration matched", "## Pushes and return maps", "Table VI", "### Push margins", "### The periodic orbit and its Floquet multipliers",
-            "## Slopes", "### The slope story, Figs. 8–9", "### Table VII", "### The slope story, Figs. 10–11",
+            "## The paper's learner on the gait searched for it", "## Slopes", "### The slope story, Figs. 8–9", "### Table VII", "### The slope story, Figs. 10–11",
             "## Time step")
 
 
@@ -108,12 +108,13 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for heading in SECTIONS:
         assert heading in text, heading
     table = [line for line in text.splitlines() if line.startswith("| ") and "**" in line]
-    assert len(table) == 14
+    assert len(table) == 16
     for row in table:  # every verdict row holds a measured number and a verdict
         ours = row.split(" | ")[2]
         assert re.search(r"\d", ours), row
     for figure in ("report_summary.png", "walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
                    "compare_learners/compare.png", "floquet/none/floquet.png",
+                   "learner_gait/learn/fig6_times.png", "learner_gait/window_map/landscape.png",
                    "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
     html = (tmp_path / "report.html").read_text()
@@ -121,8 +122,18 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     # The slope story's numbers come from its own record.
     assert summaries["slope"]["checks"]["no_window"]["climbs"]  # the climbing gait climbs 0.02 rad
     assert not summaries["slope_default"]["no_window"]["climbs"]  # the default gait does not
+    # The learner's gait: its own walk, and the window its stability runs is the learned one when a trial
+    # learned one that walks, else the map's cheapest.
+    lw, ls = summaries["learner_window_map"], summaries["learner_stability"]
+    assert lw["gait"] == "coasting_garb" and lw["baseline"]["walked"]
+    assert lw["baseline"]["cost_of_transport"] != pytest.approx(summaries["walk"]["cost_of_transport"], rel=0.05)
+    learned = [r for r in summaries["learner_learn"]["evaluation"]["learned"]
+               if not r["fell"] and r["t2"] > max(0.0, r["t1"])]
+    assert ls["window_source"].startswith("learned") == bool(learned)
+    if not learned and lw["best"] is not None:
+        assert ls["window"] == [round(lw["best"]["t1"], 4), round(lw["best"]["t2"], 4)]
 
     logs.clear()
     again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append).run_all()
-    assert logs == [f"[{step}] finished earlier: reused" for step in Reproduction.STEPS]
+    assert logs == [f"[{Reproduction.folder(step)}] finished earlier: reused" for step in Reproduction.STEPS]
     assert again == summaries and (tmp_path / "report.md").read_text() == text

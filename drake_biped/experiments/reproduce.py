@@ -15,6 +15,9 @@ functions as its own command:
     push_margin/     the largest pushes survived, none vs 0.2-0.5 s
     floquet/         the periodic orbit's Floquet multipliers: none, 0.2-0.5 s, and the learned window
     slope_default/   the default gait at the foot of 0.02 rad
+    learner_gait/    the same paper's experiments on LEARNER_GAIT, the gait searched for its learner, beside the
+                     default's: window_map/ (and the policy landscape), learn/ (Experiment 1, the paper's settings),
+                     stability/ (Table VI, push margins and 0.02 rad with the learned window)
     grid_slope/      forward lean and placement on 0.02 rad; grid_slope2deg/ on 2.0 deg (our Table VII)
     slope/, slope2deg/  the slope story with the climbing gaits (Figs. 8-11)
 
@@ -43,11 +46,17 @@ from drake_biped.records import read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-__all__ = ["FULL", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run"]
+__all__ = ["FULL", "LEARNER_GAIT", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run"]
 
 LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none under pushes (as `stability` defaults)
 SLOPE_START = {"slope": (0.1, 0.6), "slope2deg": (0.1, 0.7)}  # each climbing gait's best level window
 SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
+# The shipped gait searched for the paper's learner (docs/RESULTS.md, "A gait for the paper's learner"): its
+# window map reaches the paper's exploration (t1 to 0.8 s, t2 to 1.2 s) and its landscape is read at the
+# paper's variance and a narrower one.
+LEARNER_GAIT = "coasting_garb"
+LEARNER_MAP = (0.8, 1.2)
+LEARNER_VARIANCES = (0.04, 0.01)
 
 
 @dataclass(frozen=True)
@@ -78,9 +87,9 @@ class Profile:
 
 
 QUICK = Profile("quick", 10.0, 2, 1, (2, 6), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
-                6.0)
+                7.0)
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
-               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 390.0, compare=(5, 300))
+               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 440.0, compare=(5, 300))
 
 
 class Reproduction:
@@ -96,6 +105,13 @@ class Reproduction:
     def level(self) -> EpisodeConfig:
         """The default gait on level ground, walking the profile's distance."""
         base = EpisodeConfig()
+        return base.replace(sim=dataclasses.replace(base.sim, distance_m=self.profile.distance_m,
+                                                    max_time_s=max(base.sim.max_time_s, 6 * self.profile.distance_m)))
+
+    @property
+    def learner_level(self) -> EpisodeConfig:
+        """LEARNER_GAIT on level ground, walking the profile's distance."""
+        base = load_gait(LEARNER_GAIT)
         return base.replace(sim=dataclasses.replace(base.sim, distance_m=self.profile.distance_m,
                                                     max_time_s=max(base.sim.max_time_s, 6 * self.profile.distance_m)))
 
@@ -216,10 +232,12 @@ class Reproduction:
 
         return self.experiment("window_map", {"step_s": step, "distance_m": self.profile.distance_m}, run)
 
-    def _learn(self, name: str, trials: int, episodes: int, mean, variance: float) -> dict:
+    def _learn(self, name: str, trials: int, episodes: int, mean, variance: float,
+               config: EpisodeConfig | None = None) -> dict:
         from drake_biped.experiments import learning
 
-        settings = learning.LearningSettings(self.level, trials, episodes, 0, mean=mean, variance=variance).record()
+        settings = learning.LearningSettings(config or self.level, trials, episodes, 0, mean=mean,
+                                             variance=variance).record()
 
         def run(folder: Path) -> dict:
             record = learning.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler)
@@ -364,8 +382,93 @@ class Reproduction:
     def slope2deg(self) -> dict:
         return self._slope("slope2deg", "climbing_2deg", SLOPE_2DEG_RAD_PRINTED)
 
+    def learner_window_map(self) -> dict:
+        """LEARNER_GAIT's windows up to LEARNER_MAP against none, and what GARB's policy expects on them."""
+        from drake_biped.experiments import landscape, window_map
+
+        step, config = self.profile.window_step_s, self.learner_level
+
+        def run(folder: Path) -> dict:
+            rec = window_map.run(window_map.WindowMapSettings(config, *LEARNER_MAP, t1_step_s=step, t2_step_s=step),
+                                 folder, self._client, progress=False)
+            land = landscape.run(landscape.LandscapeSettings(str(folder / "window_map.json"), LEARNER_VARIANCES),
+                                 folder, progress=False)
+            walked = [w for w in rec["windows"] if w["walked"]]
+            best = min(walked, key=lambda w: w["cost_of_transport"], default=None)
+            base = rec["baseline"]
+            return {"gait": LEARNER_GAIT,
+                    "baseline": {k: base[k] for k in ("walked", "distance_m", "cost_of_transport", "mean_speed_mps",
+                                                      "step_period_s")},
+                    "windows": len(rec["windows"]), "walked": len(walked),
+                    "best": None if best is None else {k: best[k] for k in ("t1", "t2", "cost_of_transport",
+                                                                             "cmt_change")},
+                    "landscape": [{"variance": v["variance"], "start_gain": v["starts"][0]["gain"],
+                                   "best_gain": v["best_gain"], "best_mean": v["best_mean"]}
+                                  for v in land["variances"]]}
+
+        return self.experiment(self.folder("learner_window_map"), {"gait": LEARNER_GAIT, "config": config.to_dict(),
+                                                           "map": list(LEARNER_MAP), "step_s": step,
+                                                           "variances": list(LEARNER_VARIANCES)}, run)
+
+    def learner_learn(self) -> dict:
+        """Experiment 1 with the paper's settings on LEARNER_GAIT."""
+        trials, episodes = self.profile.learn
+        return self._learn(self.folder("learner_learn"), trials, episodes, (0.5, 0.5), 0.04, self.learner_level)
+
+    def learner_stability(self) -> dict:
+        """Table VI, the push margins and the foot of 0.02 rad for LEARNER_GAIT, none against its learned window
+        (the best learned trial's; the window map's cheapest when no trial learned one)."""
+        from drake_biped.experiments import push_margin, stability
+        from drake_biped.experiments.executor import run_kept
+        from drake_biped.experiments.learning import best_learned_trial
+        from drake_biped.experiments.slope import climbs, slope_ground
+
+        p, config = self.profile, self.learner_level
+        try:
+            row = best_learned_trial(json.loads((self.out / self.folder("learner_learn") / "learning.json").read_text()))
+            source, window = f"learned (trial {row['trial']})", (max(0.0, float(row["t1"])), float(row["t2"]))
+        except (OSError, ValueError):
+            best = read_kept(self.out / self.folder("learner_window_map") / "summary.json")["best"]
+            source, window = "the window map's cheapest (no trial learned one)", \
+                (LEVEL_WINDOW if best is None else (best["t1"], best["t2"]))
+        window = (round(window[0], 4), round(window[1], 4))
+        settings = stability.StabilitySettings(window=window, trials=p.stability_trials)
+
+        def run(folder: Path) -> dict:
+            record = stability.run(settings, folder / "table_vi", self._client, progress=False, config=config,
+                                   jacobian_kicks=())
+            cells = {c: {k: {key: record["cells"][c][k].get(key) for key in
+                             ("spectral_radius", "spectral_radius_ci", "eigenvalues", "falls", "trials", "stable",
+                              "paper_spectral_radius", "paper_eigenvalues")}
+                         for k in ("undisturbed", "forward", "backward")} for c in ("without", "with")}
+            margins = push_margin.run(push_margin.PushMarginSettings(config, window, 200.0, p.margin_tolerance_n),
+                                      folder / "push_margin", self._client, progress=False)["margins"]
+            slope = config.replace(ground=slope_ground(SLOPE_RAD),
+                                   sim=dataclasses.replace(config.sim, distance_m=EpisodeConfig().sim.distance_m))
+            jobs = {"no_window": slope, "window": slope.replace(window=TorqueFreeWindow(*window))}
+            with self.client() as client:
+                results = run_kept(client, {k: (folder / "slope" / f"{k}.json", c.to_dict()) for k, c in jobs.items()})
+            return {"window": list(window), "window_source": source, "cells": cells,
+                    "margins": {c: {d: margins[c][d]["survived_n"] for d in ("forward", "backward")}
+                                for c in ("without", "with")},
+                    "slope": {k: {"distance_m": r["distance_m"], "climbs": climbs(r)} for k, r in results.items()}}
+
+        return self.experiment(self.folder("learner_stability"), {**settings.to_dict(), "gait": LEARNER_GAIT,
+                                                          "tolerance_n": p.margin_tolerance_n,
+                                                          "slope_rad": SLOPE_RAD, "distance_m": p.distance_m}, run)
+
+    # Where a step's folder is not its name.
+    FOLDERS = {"learner_window_map": "learner_gait/window_map", "learner_learn": "learner_gait/learn",
+               "learner_stability": "learner_gait/stability"}
+
+    @classmethod
+    def folder(cls, step: str) -> str:
+        """The folder of DIR that holds `step`'s work and summary."""
+        return cls.FOLDERS.get(step, step)
+
     STEPS = ("walk", "time_step", "grid", "paper_gait", "window_map", "learn", "learn_variant", "compare_learners",
-             "stability", "push_margin", "floquet", "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
+             "stability", "push_margin", "floquet", "slope_default", "learner_window_map", "learner_learn",
+             "learner_stability", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
 
     def run_all(self) -> dict[str, dict]:
         self.out.mkdir(parents=True, exist_ok=True)
