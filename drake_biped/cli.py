@@ -77,7 +77,8 @@ _count = _integer(1)
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
     p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, coasting, "
-                   "coasting_garb, paper) or a JSON file of EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
+                   "coasting_garb, coasting_wide, paper) or a JSON file of EpisodeConfig fields (cpg, gait, "
+                   "initial, ...) or a result.json")
     p.add_argument("--distance", type=_number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
     p.add_argument("--max-time", type=_number("positive"),
                    help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
