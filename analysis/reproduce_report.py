@@ -50,12 +50,17 @@ def _read(out: Path, rel: str) -> str:
     return path.read_text() if path.is_file() else f"({rel} was not written)\n"
 
 
+def _windows_kept(evaluation: dict[str, Any]) -> int:
+    """How many trials of a learning evaluation end with a window (t̄2 > t̄1) that walks."""
+    return sum(1 for r in evaluation.get("learned", []) if r["t2"] > max(0.0, r["t1"]) and not r["fell"])
+
+
 def reduction_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
     """Verdict on "the torque-free period cuts C_mt by 40-50 % and walking holds" for a learning run."""
     reduction = evaluation.get("reduction")
     walks = evaluation.get("learned_walks", 0)
     trials = len(evaluation.get("learned", []))
-    windows = sum(1 for r in evaluation.get("learned", []) if r["t2"] > max(0.0, r["t1"]) and not r["fell"])
+    windows = _windows_kept(evaluation)
     ours = f"C_mt {_pct(None if reduction is None else -reduction)} (mean of the {walks} of {trials} trials " \
            f"that walk; {windows} end with a window)"
     if reduction is None or walks == 0:
@@ -368,9 +373,8 @@ def learner_section(out: Path, s: dict[str, dict[str, Any]], learn_verdict: str,
 
     def reduction(ev):
         red = ev.get("reduction")
-        rows = ev.get("learned", [])
-        windows = sum(1 for r in rows if r["t2"] > max(0.0, r["t1"]) and not r["fell"])
-        return f"{_pct(None if red is None else -red)} ({windows} of {len(rows)} trials end with a window)"
+        return f"{_pct(None if red is None else -red)} ({_windows_kept(ev)} of {len(ev.get('learned', []))} trials " \
+               "end with a window)"
 
     def climbs(x):
         return f"{'climbs' if x['climbs'] else 'falls'} ({x['distance_m']:.2f} m)"

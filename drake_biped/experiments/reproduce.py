@@ -101,19 +101,19 @@ class Reproduction:
         self.out, self.profile, self._client = out, profile, client
         self.workers, self.scheduler, self.log = workers, scheduler, log
 
-    @property
-    def level(self) -> EpisodeConfig:
-        """The default gait on level ground, walking the profile's distance."""
-        base = EpisodeConfig()
+    def _walking_the_distance(self, base: EpisodeConfig) -> EpisodeConfig:
         return base.replace(sim=dataclasses.replace(base.sim, distance_m=self.profile.distance_m,
                                                     max_time_s=max(base.sim.max_time_s, 6 * self.profile.distance_m)))
 
     @property
+    def level(self) -> EpisodeConfig:
+        """The default gait on level ground, walking the profile's distance."""
+        return self._walking_the_distance(EpisodeConfig())
+
+    @property
     def learner_level(self) -> EpisodeConfig:
         """LEARNER_GAIT on level ground, walking the profile's distance."""
-        base = load_gait(LEARNER_GAIT)
-        return base.replace(sim=dataclasses.replace(base.sim, distance_m=self.profile.distance_m,
-                                                    max_time_s=max(base.sim.max_time_s, 6 * self.profile.distance_m)))
+        return self._walking_the_distance(load_gait(LEARNER_GAIT))
 
     def client(self):
         """The reproduction's one client, as a context (it is closed by whoever opened it)."""
@@ -223,12 +223,7 @@ class Reproduction:
         def run(folder: Path) -> dict:
             rec = window_map.run(window_map.WindowMapSettings(self.level, t1_step_s=step, t2_step_s=step), folder,
                                  self._client, progress=False)
-            walked = [w for w in rec["windows"] if w["walked"]]
-            best = min(walked, key=lambda w: w["cost_of_transport"], default=None)
-            return {"no_window_cost_of_transport": rec["baseline"]["cost_of_transport"],
-                    "windows": len(rec["windows"]), "walked": len(walked),
-                    "best": None if best is None else {k: best[k] for k in ("t1", "t2", "cost_of_transport",
-                                                                             "cmt_change")}}
+            return {"no_window_cost_of_transport": rec["baseline"]["cost_of_transport"], **_map_summary(rec)}
 
         return self.experiment("window_map", {"step_s": step, "distance_m": self.profile.distance_m}, run)
 
@@ -264,11 +259,7 @@ class Reproduction:
         def run(folder: Path) -> dict:
             record = stability.run(settings, folder, self._client, progress=False, config=self.level,
                                    jacobian_kicks=stability.JACOBIAN_KICKS_RAD if p.jacobian else ())
-            cells = {c: {k: {key: record["cells"][c][k].get(key) for key in
-                             ("spectral_radius", "spectral_radius_ci", "eigenvalues", "falls", "trials", "stable",
-                              "paper_spectral_radius", "paper_eigenvalues")}
-                         for k in ("undisturbed", "forward", "backward")} for c in ("without", "with")}
-            return {"cells": cells}
+            return {"cells": _cells(record)}
 
         return self.experiment("stability", {**settings.to_dict(), "jacobian": p.jacobian,
                                              "distance_m": p.distance_m}, run)
@@ -281,8 +272,7 @@ class Reproduction:
         def run(folder: Path) -> dict:
             record = push_margin.run(push_margin.PushMarginSettings(self.level, LEVEL_WINDOW, 200.0, tol), folder,
                                      self._client, progress=False)
-            return {"margins": {c: {d: record["margins"][c][d]["survived_n"] for d in ("forward", "backward")}
-                                for c in ("without", "with")}}
+            return {"margins": _margins(record)}
 
         return self.experiment("push_margin", {"tolerance_n": tol, "window": list(LEVEL_WINDOW),
                                                "distance_m": self.profile.distance_m}, run)
@@ -393,15 +383,11 @@ class Reproduction:
                                  folder, self._client, progress=False)
             land = landscape.run(landscape.LandscapeSettings(str(folder / "window_map.json"), LEARNER_VARIANCES),
                                  folder, progress=False)
-            walked = [w for w in rec["windows"] if w["walked"]]
-            best = min(walked, key=lambda w: w["cost_of_transport"], default=None)
             base = rec["baseline"]
             return {"gait": LEARNER_GAIT,
                     "baseline": {k: base[k] for k in ("walked", "distance_m", "cost_of_transport", "mean_speed_mps",
                                                       "step_period_s")},
-                    "windows": len(rec["windows"]), "walked": len(walked),
-                    "best": None if best is None else {k: best[k] for k in ("t1", "t2", "cost_of_transport",
-                                                                             "cmt_change")},
+                    **_map_summary(rec),
                     "landscape": [{"variance": v["variance"], "start_gain": v["starts"][0]["gain"],
                                    "best_gain": v["best_gain"], "best_mean": v["best_mean"]}
                                   for v in land["variances"]]}
@@ -435,22 +421,17 @@ class Reproduction:
         settings = stability.StabilitySettings(window=window, trials=p.stability_trials)
 
         def run(folder: Path) -> dict:
-            record = stability.run(settings, folder / "table_vi", self._client, progress=False, config=config,
-                                   jacobian_kicks=())
-            cells = {c: {k: {key: record["cells"][c][k].get(key) for key in
-                             ("spectral_radius", "spectral_radius_ci", "eigenvalues", "falls", "trials", "stable",
-                              "paper_spectral_radius", "paper_eigenvalues")}
-                         for k in ("undisturbed", "forward", "backward")} for c in ("without", "with")}
-            margins = push_margin.run(push_margin.PushMarginSettings(config, window, 200.0, p.margin_tolerance_n),
-                                      folder / "push_margin", self._client, progress=False)["margins"]
+            cells = _cells(stability.run(settings, folder / "table_vi", self._client, progress=False, config=config,
+                                         jacobian_kicks=()))
+            margins = _margins(push_margin.run(push_margin.PushMarginSettings(config, window, 200.0,
+                                                                              p.margin_tolerance_n),
+                                               folder / "push_margin", self._client, progress=False))
             slope = config.replace(ground=slope_ground(SLOPE_RAD),
                                    sim=dataclasses.replace(config.sim, distance_m=EpisodeConfig().sim.distance_m))
             jobs = {"no_window": slope, "window": slope.replace(window=TorqueFreeWindow(*window))}
             with self.client() as client:
                 results = run_kept(client, {k: (folder / "slope" / f"{k}.json", c.to_dict()) for k, c in jobs.items()})
-            return {"window": list(window), "window_source": source, "cells": cells,
-                    "margins": {c: {d: margins[c][d]["survived_n"] for d in ("forward", "backward")}
-                                for c in ("without", "with")},
+            return {"window": list(window), "window_source": source, "cells": cells, "margins": margins,
                     "slope": {k: {"distance_m": r["distance_m"], "climbs": climbs(r)} for k, r in results.items()}}
 
         return self.experiment(self.folder("learner_stability"), {**settings.to_dict(), "gait": LEARNER_GAIT,
@@ -480,6 +461,27 @@ class Reproduction:
 
         write_report(self.out, summaries, self.profile, code)
         return summaries
+
+
+def _map_summary(record: dict) -> dict:
+    """A window map's count of windows, of those that walk, and its cheapest walking window."""
+    walked = [w for w in record["windows"] if w["walked"]]
+    best = min(walked, key=lambda w: w["cost_of_transport"], default=None)
+    return {"windows": len(record["windows"]), "walked": len(walked),
+            "best": None if best is None else {k: best[k] for k in ("t1", "t2", "cost_of_transport", "cmt_change")}}
+
+
+def _cells(record: dict) -> dict:
+    """What the report needs of a stability record's six cells."""
+    keys = ("spectral_radius", "spectral_radius_ci", "eigenvalues", "falls", "trials", "stable",
+            "paper_spectral_radius", "paper_eigenvalues")
+    return {c: {k: {key: record["cells"][c][k].get(key) for key in keys} for k in ("undisturbed", "forward", "backward")}
+            for c in ("without", "with")}
+
+
+def _margins(record: dict) -> dict:
+    """A push-margin record's survived forces, without and with the window, forward and backward."""
+    return {c: {d: record["margins"][c][d]["survived_n"] for d in ("forward", "backward")} for c in ("without", "with")}
 
 
 @dataclass(frozen=True)
