@@ -125,7 +125,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     # The learner's gait: its own walk, and the window its stability runs is the learned one when a trial
     # learned one that walks, else the map's cheapest.
     lw, ls = summaries["learner_window_map"], summaries["learner_stability"]
-    assert lw["gait"] == "coasting_garb" and lw["baseline"]["walked"]
+    assert lw["gait"] == "coasting_wide" and lw["baseline"]["walked"]
     assert lw["baseline"]["cost_of_transport"] != pytest.approx(summaries["walk"]["cost_of_transport"], rel=0.05)
     learned = [r for r in summaries["learner_learn"]["evaluation"]["learned"]
                if not r["fell"] and r["t2"] > max(0.0, r["t1"])]
