@@ -188,7 +188,12 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
     if args.replot:
         rec = time_step.replot(out)
     else:
-        settings = time_step.TimeStepSettings(tuple(args.steps), args.reference, args.distance)
+        from drake_biped.resources import load_gait
+
+        config = None if args.params is None else load_gait(args.params)
+        settings = time_step.TimeStepSettings(tuple(args.steps), args.reference, args.distance, config,
+                                              "Default gait" if args.params is None else f"Gait {args.params}",
+                                              None if args.windows is None else tuple(args.windows))
         with _client(args) as client:
             rec = time_step.run(settings, out, client)
     print((out / "time_step_study.md").read_text())
@@ -386,6 +391,20 @@ def _steps(text: str) -> list[float]:
     return [parse(t) for t in text.split(",")]
 
 
+def _windows(text: str) -> list[tuple[float, float]]:
+    parse = _number("nonnegative")
+    out = []
+    for t in text.split(","):
+        ends = t.split("-")
+        if len(ends) != 2:
+            raise argparse.ArgumentTypeError(f"{t!r}: a window is T1-T2 in seconds, e.g. 0.3-0.7")
+        t1, t2 = parse(ends[0]), parse(ends[1])
+        if t2 <= t1:
+            raise argparse.ArgumentTypeError(f"{t!r}: need T1 < T2")
+        out.append((t1, t2))
+    return out
+
+
 def _learner_names(text: str) -> list[str]:
     from drake_biped.learners.registry import LEARNERS
 
@@ -523,6 +542,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help="time steps (s), comma-separated (default 0.00025,0.0005,0.001,0.002,0.005)")
     ts.add_argument("--reference", type=_number("positive"), default=0.0005, help="reference step (s), one of --steps")
     ts.add_argument("--distance", type=_number("positive"), default=10.0, help="walk this far (m); default 10")
+    ts.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
+                    "default gait. Its own time step is replaced by each of --steps")
+    ts.add_argument("--windows", type=_windows,
+                    help="the windows compared with none, T1-T2 in s, comma-separated (default "
+                         "0.1-0.4,0.2-0.5,0.3-0.6,0.35-0.65,0.2-0.7)")
     _add_cluster_options(ts)
     ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
     ts.add_argument("--out", required=True, type=_out_folder, help="output folder")

@@ -50,3 +50,32 @@ def test_reference_outside_the_steps_is_refused(tmp_path, capsys):
         main(["time-step-study", "--out", str(tmp_path), "--steps", "0.001,0.002", "--reference", "0.0005"])
     assert exc.value.code == 2
     assert "--reference" in capsys.readouterr().err
+
+
+def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
+    """The study walks the given gait (its CPG and gains kept, its time step replaced) with no window and
+    each given window, and its tables list those windows."""
+    from drake_biped.experiments import time_step
+    from drake_biped.resources import load_gait
+
+    gait = load_gait("coasting_wide")
+    seen = []
+
+    def fake_map(client, fn, items, progress=None):
+        seen.extend(items)
+        return [{"fell": False, "distance_m": 10.0, "cost_of_transport": 0.5 - c["window"]["end_s"] / 10,
+                 "mean_speed_mps": 1.0, "step_period_s": 0.4, "real_time_factor": 5.0} for c in items]
+
+    monkeypatch.setattr(time_step, "map_ordered", fake_map)
+    rec = time_step.study([0.0005, 0.001], 0.0005, 10.0, None, progress=False, config=gait,
+                          windows=[(0.3, 0.7), (0.5, 1.0)])
+    assert len(seen) == 6
+    assert {c["cpg"]["u_r"] for c in seen} == {gait.cpg.u_r}
+    assert {c["gait"]["torso_pitch_rad"] for c in seen} == {gait.gait.torso_pitch_rad}
+    assert sorted({(c["sim"]["time_step_s"], c["sim"]["control_period_s"]) for c in seen}) == [
+        (0.0005, 0.0005), (0.001, 0.001)]
+    assert {(c["window"]["start_s"], c["window"]["end_s"]) for c in seen} == {(0.0, 0.0), (0.3, 0.7), (0.5, 1.0)}
+    assert rec["walks"] == [None, [0.3, 0.7], [0.5, 1.0]] and rec["chosen_step_s"] == 0.001
+    rec.update(gait="Gait coasting_wide", versions={"git_commit": "x", "drake": "y"}, date="d")
+    table = time_step.markdown(rec)
+    assert "Gait coasting_wide" in table and "| window 0.5–1 s |" in table and "0.2–0.5" not in table

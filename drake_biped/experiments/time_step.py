@@ -1,5 +1,6 @@
-"""Time-step study: C_mt, speed and step period of the default gait, with no window and with the
-acceptance windows, against the plant (and control) time step. The default step is the largest whose
+"""Time-step study: C_mt, speed and step period of a gait (the default one unless given), with no window
+and with a set of windows (the default gait's acceptance windows unless given), against the plant (and
+control) time step. The default step is the largest whose
 C_mt stays within 2 % of the 0.5 ms reference for every walk that walks at the reference step.
 
 `drake-biped time-step-study --out DIR` (or `python benchmarks/time_step_study.py --out DIR`) writes
@@ -9,6 +10,7 @@ the controller runs at the time step. Episodes run on Dask (a LocalCluster, or a
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from dataclasses import dataclass
@@ -16,7 +18,7 @@ from pathlib import Path
 
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
-from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
 from drake_biped.records import read_json, save_figure, write_text_atomic
 from drake_biped.versions import versions
 
@@ -28,13 +30,22 @@ def label(window) -> str:
     return "no window" if window is None else f"window {window[0]:g}–{window[1]:g} s"
 
 
-def study(steps: list[float], reference: float, distance: float, client, progress: bool = True) -> dict:
+def walks(windows) -> list:
+    """The walks a study compares: no window first, then each (t1, t2)."""
+    return [None, *[tuple(w) for w in windows]]
+
+
+def study(steps: list[float], reference: float, distance: float, client, progress: bool = True,
+          config: EpisodeConfig | None = None, windows=None) -> dict:
+    base = config if config is not None else EpisodeConfig()
+    walk_list = walks(windows) if windows is not None else WALKS
     jobs = []
     for h in steps:
-        for w in WALKS:
-            sim = SimulationParams(time_step_s=h, control_period_s=h, distance_m=distance)
+        for w in walk_list:
+            sim = dataclasses.replace(base.sim, time_step_s=h, control_period_s=h, distance_m=distance,
+                                      max_time_s=max(base.sim.max_time_s, 6.0 * distance))
             window = TorqueFreeWindow(*w) if w else TorqueFreeWindow(0.0, 0.0)
-            jobs.append((h, w, EpisodeConfig(sim=sim, window=window).to_dict()))
+            jobs.append((h, w, base.replace(sim=sim, window=window).to_dict()))
     from tqdm import tqdm
 
     with tqdm(total=len(jobs), desc="time-step study", unit="episode", disable=not progress) as bar:
@@ -52,7 +63,13 @@ def study(steps: list[float], reference: float, distance: float, client, progres
             "real_time_factor": r["real_time_factor"],
         })
     return {"steps": steps, "reference_s": reference, "distance_m": distance, "tolerance": TOLERANCE,
+            "walks": [list(w) if w else None for w in walk_list], "config": base.to_dict(),
             "rows": rows, **choose_step(rows, steps, reference, TOLERANCE)}
+
+
+def _walks_of(rec: dict) -> list:
+    """The record's walks (records written before walks were recorded used WALKS)."""
+    return [tuple(w) if w else None for w in rec["walks"]] if "walks" in rec else WALKS
 
 
 def choose_step(rows: list[dict], steps: list[float], reference: float, tolerance: float) -> dict:
@@ -91,7 +108,7 @@ def markdown(rec: dict) -> str:
 
     def table(fmt) -> list[str]:
         out = [head, sep]
-        for w in WALKS:
+        for w in _walks_of(rec):
             cells = [fmt(by[(h, tuple(w or ()))]) for h in steps]
             out.append(f"| {label(w)} | " + " | ".join(cells) + " |")
         return out
@@ -107,7 +124,7 @@ def markdown(rec: dict) -> str:
     lines = [
         "# Time-step study",
         "",
-        f"Default gait, {rec['distance_m']:g} m walks from the paper's initiation; plant and controller at the time "
+        f"{rec.get('gait', 'Default gait')}, {rec['distance_m']:g} m walks from the paper's initiation; plant and controller at the time "
         f"step; reference {rec['reference_s'] * 1e3:g} ms. Commit {rec['versions']['git_commit']}, "
         f"Drake {rec['versions']['drake']}, {rec['date']}.",
         "",
@@ -145,7 +162,7 @@ def figure(rec: dict, path: Path) -> None:
 
     fig, ax = plt.subplots(figsize=(6.5, 4.0))
     steps_ms = [h * 1e3 for h in rec["steps"]]
-    for w in WALKS:
+    for w in _walks_of(rec):
         rows = [r for r in rec["rows"] if tuple(r["window"] or ()) == tuple(w or ())]
         ys = [100 * r["cmt_deviation"] if r["cmt_deviation"] is not None else float("nan") for r in rows]
         ax.plot(steps_ms, ys, "o-", label=label(w))
@@ -168,15 +185,23 @@ def figure(rec: dict, path: Path) -> None:
 
 @dataclass(frozen=True)
 class TimeStepSettings:
-    """The time steps compared (s), the reference among them, and the distance walked."""
+    """The time steps compared (s), the reference among them, the distance walked, the gait (None: the
+    default one; its own time step is replaced by each of `steps`), its name for the report, and the
+    windows (t1, t2) compared with none (None: WALKS')."""
 
     steps: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.005)
     reference_s: float = 0.0005
     distance_m: float = 10.0
+    config: EpisodeConfig | None = None
+    gait: str = "Default gait"
+    windows: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         if self.reference_s not in self.steps:
             raise ParameterError(f"--reference {self.reference_s!r} must be one of --steps {sorted(self.steps)}")
+        for t1, t2 in self.windows or ():
+            if not 0.0 <= t1 < t2:
+                raise ParameterError(f"--windows {t1:g}-{t2:g}: need 0 <= t1 < t2")
 
 
 def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = True) -> dict:
@@ -189,8 +214,9 @@ def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = Tru
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     with client_or_local(client) as c:
-        rec = study(steps, settings.reference_s, settings.distance_m, c, progress)
-    rec.update(date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), versions=versions(), wall_s=time.perf_counter() - t0)
+        rec = study(steps, settings.reference_s, settings.distance_m, c, progress, settings.config,
+                    settings.windows)
+    rec.update(gait=settings.gait, date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), versions=versions(), wall_s=time.perf_counter() - t0)
     write_text_atomic(out / "time_step_study.json", json.dumps(rec, indent=2) + "\n")
     replot(out)
     return rec
