@@ -30,15 +30,10 @@ def label(window) -> str:
     return "no window" if window is None else f"window {window[0]:g}–{window[1]:g} s"
 
 
-def walks(windows) -> list:
-    """The walks a study compares: no window first, then each (t1, t2)."""
-    return [None, *[tuple(w) for w in windows]]
-
-
 def study(steps: list[float], reference: float, distance: float, client, progress: bool = True,
           config: EpisodeConfig | None = None, windows=None) -> dict:
     base = config if config is not None else EpisodeConfig()
-    walk_list = walks(windows) if windows is not None else WALKS
+    walk_list = WALKS if windows is None else [None, *map(tuple, windows)]
     jobs = []
     for h in steps:
         for w in walk_list:
@@ -187,7 +182,7 @@ def figure(rec: dict, path: Path) -> None:
 class TimeStepSettings:
     """The time steps compared (s), the reference among them, the distance walked, the gait (None: the
     default one; its own time step is replaced by each of `steps`), its name for the report, and the
-    windows (t1, t2) compared with none (None: WALKS')."""
+    windows (t1, t2) compared with none (None: those of WALKS)."""
 
     steps: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.005)
     reference_s: float = 0.0005
