@@ -391,6 +391,8 @@ def learner_section(out: Path, s: dict[str, dict[str, Any]], learn_verdict: str,
         "",
         f"| | default gait | `{gait}` |",
         "|---|---|---|",
+        f"| time step (plant and controller) | {_ms(s['learn']['settings']['config'])} | "
+        f"{_ms(lw['settings']['config'])} |",
         f"| no window: C_mt, speed, step | {_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, "
         f"{_num(walk['step_period_s'])} s | {_num(base['cost_of_transport'])}, {_num(base['mean_speed_mps'], 2)} m/s, "
         f"{_num(base['step_period_s'])} s |",
@@ -427,6 +429,11 @@ def learner_section(out: Path, s: dict[str, dict[str, Any]], learn_verdict: str,
         embed(_read(out, "learner_gait/stability/table_vi/report.md"), "learner_gait/stability/table_vi"),
     ]
     return lines
+
+
+def _ms(config: dict[str, Any]) -> str:
+    """A recorded configuration's plant time step, in ms."""
+    return f"{1e3 * config['sim']['time_step_s']:g} ms"
 
 
 def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: Path) -> None:

@@ -158,8 +158,34 @@ def test_nearest_objective_prefers_the_walker_nearest_table_iii(monkeypatch):
     near = EpisodeConfig(cpg=PAPER_CPG.__class__(u_a=2.2, u_r=2.1, kappa=1.8))
     far = EpisodeConfig()  # the default gait's CPG: u_r 4.6
     assert gait_search.score(EpisodeConfig(cpg=PAPER_CPG), objective="nearest")[0] == 0.0
-    assert gait_search.score(near, objective="nearest")[0] == pytest.approx(-math.log(1.1))
+    d = math.log(1.1)
+    assert gait_search.score(near, objective="nearest")[0] == pytest.approx(-d / (1 + d) / 3)
     assert gait_search.score(far, objective="nearest")[0] < gait_search.score(near, objective="nearest")[0]
+
+
+def test_nearest_objective_ranks_a_walker_that_survives_the_pushes_first(monkeypatch):
+    # A walker that reaches the distance only undisturbed (a lucky walk near a cliff in the parameters) falls
+    # to a push; any walker beats every fall, and surviving both pushes beats any nearness.
+    def fake(walks_pushed):
+        def walk(config):
+            pushed = config.push is not None and config.push.force_n != 0.0
+            walked = walks_pushed or not pushed
+            return {"walked": walked, "cost_of_transport": 0.2, "distance_m": 6.0 if walked else 5.9,
+                    "reward": 5.0}
+        return walk
+
+    exact = EpisodeConfig(cpg=PAPER_CPG).override({"sim.distance_m": 6.0})
+    far = EpisodeConfig().override({"sim.distance_m": 6.0, "u_r": 30.0, "u_a": 0.05})
+    monkeypatch.setattr(gait_search, "_walk", fake(walks_pushed=False))
+    lucky, detail = gait_search.score(exact, objective="nearest")
+    assert [p["push_n"] for p in detail["pushes"]] == [gait_search.PUSH_FORCE_N, -gait_search.PUSH_FORCE_N]
+    monkeypatch.setattr(gait_search, "_walk", fake(walks_pushed=True))
+    robust_far = gait_search.score(far, objective="nearest")[0]
+    monkeypatch.setattr(gait_search, "_walk", lambda config: {"walked": False, "cost_of_transport": 0.3,
+                                                              "distance_m": 5.9, "reward": 3.0})
+    fall = gait_search.score(exact, objective="nearest")[0]
+    assert lucky == pytest.approx(-2.0 / 3.0)
+    assert fall < -1.0 < lucky < robust_far < 0.0
 
 
 def test_coast_objective_scores_windows_that_run_to_touchdown(monkeypatch):

@@ -13,8 +13,11 @@ walks, by the objective:
 - "walk": 0 (the search stops improving once a walker is found; use it to find one);
 - "coast": the same score over COAST_WINDOWS, the hip off from t1 = 0.2 ... 0.5 s until the swing foot
   lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau);
-- "nearest": minus the CPG's distance from Table III (`distance_from_table_iii`), to find the walker whose
-  CPG is nearest the paper's (with the "near_paper" mutations);
+- "nearest": -(d / (1 + d) + f) / 3, d the CPG's distance from Table III (`distance_from_table_iii`) and f
+  how many of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through, to
+  find the walker whose CPG is nearest the paper's (with the "near_paper" mutations); in (-1, 0], so any
+  walker, however far, beats every fall, and one that survives both pushes beats every one that does not
+  (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push);
 - "floquet": (1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit
   (`floquet.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map):
   positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3;
@@ -186,6 +189,19 @@ def _window_rows(config: EpisodeConfig, windows, base: dict[str, Any]) -> list[d
     return rows
 
 
+def _push_rows(config: EpisodeConfig) -> list[dict[str, Any]]:
+    """`_walk` of `config` without a window under a forward and a backward push of PUSH_FORCE_N (stability's
+    timing), each row tagged with its force."""
+    from drake_biped.params import Push
+
+    rows = []
+    for sign in (1.0, -1.0):
+        row = _walk(config.replace(window=TorqueFreeWindow(), push=Push(sign * PUSH_FORCE_N)))
+        row["push_n"] = sign * PUSH_FORCE_N
+        rows.append(row)
+    return rows
+
+
 def _orbit_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
     """(1 - rho) / (1 + rho) of the period-1 orbit's spectral radius rho (in (-1, 1], positive once the orbit
     attracts), mapped into (-1, 0) when Newton left a residual above 1e-3, and FLOQUET_UNDEFINED when the
@@ -209,7 +225,6 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     import numpy as np
 
     from drake_biped.analysis.landscape import WindowRewards, landscape
-    from drake_biped.params import Push
 
     rows = _window_rows(config, LANDSCAPE_WINDOWS, base)
     rewards = WindowRewards(np.array([r["window"] for r in rows]), np.array([r["reward"] for r in rows]),
@@ -217,11 +232,7 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     land = landscape(rewards, [POLICY_VARIANCE], t2_range=(0.0, 1.2), step=0.05, samples=1000,
                      starts=(POLICY_START,))["variances"][0]
     start_gain, best_gain = land["starts"][0]["gain"], land["best_gain"]
-    pushes = []
-    for sign in (1.0, -1.0):
-        row = _walk(config.replace(window=TorqueFreeWindow(), push=Push(sign * PUSH_FORCE_N)))
-        row["push_n"] = sign * PUSH_FORCE_N
-        pushes.append(row)
+    pushes = _push_rows(config)
     failed = sum(not p["walked"] for p in pushes)
     value = start_gain + 0.5 * min(max(0.0, best_gain), BEST_GAIN_CAP) - PUSH_PENALTY * failed
     return value, {"baseline": base, "windows": rows, "pushes": pushes,
@@ -239,7 +250,11 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
     if objective == "walk":
         return 0.0, {"baseline": base, "windows": []}
     if objective == "nearest":
-        return -distance_from_table_iii(config.cpg), {"baseline": base, "windows": []}
+        d = distance_from_table_iii(config.cpg)
+        pushes = _push_rows(config)
+        failed = sum(not p["walked"] for p in pushes)
+        return -(d / (1.0 + d) + failed) / 3.0, {"baseline": base, "windows": [], "pushes": pushes,
+                                                "distance_from_table_iii": d}
     if objective == "floquet":
         return _orbit_score(config, base)
     if objective == "landscape":
