@@ -524,7 +524,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
                              "find a walker), 'policy' (the expected reward of the paper's start policy, plus "
                              "half its best draw's), 'expected' (that expected reward alone), "
-                             "'nearest' (the CPG's nearness to Table III), 'coast' (hip off from t1 until "
+                             "'nearest' (the CPG's nearness to Table III, and surviving +-20 N pushes), 'coast' (hip off from t1 until "
                              "touchdown), 'floquet' ((1 - rho)/(1 + rho) of the period-1 orbit), 'landscape' "
                              "(the paper's start policy's expected gain on a coarse window map, half the best "
                              "mean's up to 0.2, less 0.25 a failed 20 N push)")
