@@ -447,9 +447,11 @@ class Reproduction:
         """The folder of DIR that holds `step`'s work and summary."""
         return cls.FOLDERS.get(step, step)
 
-    STEPS = ("walk", "time_step", "grid", "paper_gait", "window_map", "learn", "learn_variant", "compare_learners",
-             "stability", "push_margin", "floquet", "slope_default", "learner_window_map", "learner_learn",
-             "learner_stability", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
+    # The learner's gait, which carries the paper's learning result, runs early, so that an interrupted run
+    # has it first.
+    STEPS = ("walk", "time_step", "grid", "paper_gait", "learner_window_map", "learner_learn", "learner_stability",
+             "window_map", "learn", "learn_variant", "compare_learners", "stability", "push_margin", "floquet",
+             "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
 
     def run_all(self) -> dict[str, dict]:
         self.out.mkdir(parents=True, exist_ok=True)
