@@ -23,6 +23,9 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
+# Newton's default tolerance on the relative residual |P(x) - x| / |x| of the gait's fixed point.
+NEWTON_TOLERANCE = 1e-9
+
 Batch = Callable[[Sequence[np.ndarray]], Sequence[np.ndarray | None]]
 
 
@@ -225,6 +228,17 @@ def named_components(vector: np.ndarray, names: Sequence[str], count: int = 4) -
     order = np.argsort(-np.abs(v))[:count]
     return [{"name": names[i], "re": float(v[i].real), "im": float(v[i].imag), "magnitude": float(abs(v[i]))}
             for i in order]
+
+
+def orbit_verdict(spectral_radius: float, converged_epsilon: float | None, fixed_point_residual: float,
+                  tolerance: float) -> str:
+    """What multipliers establish: "stable" or "unstable" where Newton reached `tolerance` (relative
+    residual) and the perturbation sweep converged; otherwise "not established" and why."""
+    if converged_epsilon is None:
+        return "not established: the Jacobian did not converge"
+    if fixed_point_residual > tolerance:
+        return f"not established: Newton stopped at residual {fixed_point_residual:.1e}, above {tolerance:.0e}"
+    return "stable" if spectral_radius < 1 else "unstable"
 
 
 def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) -> np.ndarray:

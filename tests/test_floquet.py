@@ -68,6 +68,15 @@ def test_converged_epsilon_takes_the_longest_run_and_reports_none_without_one():
     assert none["epsilon"] is None
 
 
+def test_the_orbit_verdict_needs_newton_and_the_sweep_to_have_converged():
+    assert fq.orbit_verdict(0.4, 1e-6, 1e-10, 1e-9) == "stable"
+    assert fq.orbit_verdict(13.2, 1e-6, 1e-10, 1e-9) == "unstable"
+    # a Jacobian with no plateau, or one taken where Newton stopped short of a fixed point, decides nothing
+    assert fq.orbit_verdict(104.0, None, 1e-10, 1e-9) == "not established: the Jacobian did not converge"
+    assert fq.orbit_verdict(0.4, 1e-6, 5.1e-3, 1e-9) == ("not established: Newton stopped at residual 5.1e-03, "
+                                                         "above 1e-09")
+
+
 def test_prediction_of_a_linear_map_is_exact():
     rng = np.random.default_rng(1)
     a = rng.normal(size=(3, 3)) * 0.4

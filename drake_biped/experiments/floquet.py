@@ -38,7 +38,7 @@ class FloquetSettings:
     settle_steps: int = 8
     epsilons: tuple[float, ...] = DEFAULT_EPSILONS
     newton_epsilon: float = 1e-6
-    newton_tolerance: float = 1e-9
+    newton_tolerance: float = fq.NEWTON_TOLERANCE
     newton_iterations: int = 6
     plateau_tolerance: float = 0.05
     decay_steps: int = 5
@@ -108,7 +108,8 @@ def orbit_radius(config: EpisodeConfig, settle_steps: int = 8, epsilon: float = 
     section_map = SectionMap(config)
     z0, template = section_map.start(settle_steps)
     evaluate = fq.serial(lambda z: section_map.step(z, template))
-    fixed = fq.newton_fixed_point(evaluate, z0, epsilon, tolerance=1e-9, max_iterations=iterations)
+    fixed = fq.newton_fixed_point(evaluate, z0, epsilon, tolerance=fq.NEWTON_TOLERANCE,
+                                  max_iterations=iterations)
     jac = fq.difference_jacobian(evaluate, fixed.state, epsilon)
     mult = fq.multipliers(jac, section_map.section_normal())
     return {"spectral_radius": mult.nontrivial_radius(), "fixed_point_residual": fixed.residual}
@@ -199,6 +200,16 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     }
 
 
+def orbit_verdict(record: dict[str, Any]) -> str:
+    """What a record's multipliers establish (`fq.orbit_verdict`). `record`: floquet.json's record, or a
+    summary of it holding spectral_radius, converged_epsilon and fixed_point_residual (judged against
+    the default tolerance where it holds no settings)."""
+    default = record.get("newton_tolerance", fq.NEWTON_TOLERANCE)
+    tolerance = record.get("settings", {}).get("newton_tolerance", default)
+    return fq.orbit_verdict(record["spectral_radius"], record["converged_epsilon"], record["fixed_point_residual"],
+                            tolerance)
+
+
 def _fmt(value: float | None, spec: str = ".4g") -> str:
     return "—" if value is None else format(value, spec)
 
@@ -222,8 +233,9 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
         lines.append("No two neighbouring perturbation sizes agree: the Jacobian did not converge.")
     lines += ["", "| ε | spectral radius |", "|---|---|"]
     lines += [f"| {r['epsilon']:.1e} | {_fmt(r['spectral_radius'])} |" for r in record["epsilon_sweep"]]
-    lines += ["", f"**Spectral radius {record['spectral_radius']:.4f}** "
-              f"({'stable' if record['spectral_radius'] < 1 else 'unstable'} period-1 orbit). Multipliers, largest first:",
+    verdict = orbit_verdict(record)
+    verdict = f"{verdict} period-1 orbit" if verdict in ("stable", "unstable") else verdict
+    lines += ["", f"**Spectral radius {record['spectral_radius']:.4f}** ({verdict}). Multipliers, largest first:",
               "", "| multiplier | modulus | mode (largest components) |", "|---|---|---|"]
     modes = {tuple(m["multiplier"]): m for m in record["dominant_modes"]}
     for k, (re, im) in enumerate(record["multipliers"][:6]):

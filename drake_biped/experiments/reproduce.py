@@ -89,7 +89,7 @@ class Profile:
 QUICK = Profile("quick", 10.0, 2, 1, (2, 6), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 7.0)
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
-               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 500.0, compare=(5, 300))
+               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 455.0, compare=(5, 300))
 
 
 class Reproduction:
@@ -300,7 +300,7 @@ class Reproduction:
                 record = floquet.run(settings, folder / name, self._client)
                 out[name] = {"window": [t1, t2], **{k: record[k] for k in (
                     "spectral_radius", "converged_epsilon", "fixed_point_residual", "multipliers", "plateau",
-                    "sampling_phase_drift")}, "decay": {k: record["decay"][k] for k in (
+                    "sampling_phase_drift")}, "newton_tolerance": record["settings"]["newton_tolerance"], "decay": {k: record["decay"][k] for k in (
                         "predicted", "map_iterated", "continued")}, "wall_time_s": record["wall_time_s"]}
             return {"gaits": out}
 
