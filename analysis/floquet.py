@@ -241,6 +241,16 @@ def orbit_verdict(spectral_radius: float, converged_epsilon: float | None, fixed
     return "stable" if spectral_radius < 1 else "unstable"
 
 
+def record_verdict(record: dict[str, Any]) -> str:
+    """`orbit_verdict` of a Floquet record (floquet.json's), or of a summary holding its spectral_radius,
+    converged_epsilon, fixed_point_residual and newton_tolerance (NEWTON_TOLERANCE where it holds neither
+    that nor the record's settings)."""
+    default = record.get("newton_tolerance", NEWTON_TOLERANCE)
+    tolerance = record.get("settings", {}).get("newton_tolerance", default)
+    return orbit_verdict(record["spectral_radius"], record["converged_epsilon"], record["fixed_point_residual"],
+                         tolerance)
+
+
 def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) -> np.ndarray:
     """J^k δ for k = 1..steps, one row per step: the linearisation's prediction of a perturbation's
     deviation from the fixed point after k steps."""

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from drake_biped.analysis.floquet import NEWTON_TOLERANCE, orbit_verdict
+from drake_biped.analysis.floquet import record_verdict
 from drake_biped.analysis.series import signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
@@ -31,12 +31,6 @@ def _pct(x: float | None) -> str:
 
 def _num(x: float | None, digits: int = 3) -> str:
     return "—" if x is None else f"{x:.{digits}f}"
-
-
-def _orbit(gait: dict[str, Any]) -> str:
-    """A Floquet summary's verdict on its orbit (the default tolerance for summaries that do not hold theirs)."""
-    return orbit_verdict(gait["spectral_radius"], gait["converged_epsilon"], gait["fixed_point_residual"],
-                         gait.get("newton_tolerance", NEWTON_TOLERANCE))
 
 
 def embed(markdown: str, folder: str) -> str:
@@ -160,8 +154,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                      f"{m['with']['backward']:.0f} N", BEYOND))
     fl = s["floquet"]["gaits"]
     verdicts.append(("Full-state Floquet multipliers (periodic orbit, through Drake)", "—",
-                     ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({_orbit(g)})" for name, g in fl.items()),
-                     BEYOND))
+                     ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
+                               for name, g in fl.items()), BEYOND))
     lw, ll, ls = s["learner_window_map"], s["learner_learn"], s["learner_stability"]
     gait = lw["gait"]
     lrn_ours, lrn_verdict = reduction_verdict(ll["evaluation"])

@@ -75,6 +75,11 @@ def test_the_orbit_verdict_needs_newton_and_the_sweep_to_have_converged():
     assert fq.orbit_verdict(104.0, None, 1e-10, 1e-9) == "not established: the Jacobian did not converge"
     assert fq.orbit_verdict(0.4, 1e-6, 5.1e-3, 1e-9) == ("not established: Newton stopped at residual 5.1e-03, "
                                                          "above 1e-09")
+    # a record is judged against its own settings' tolerance, a summary against the one it holds
+    record = {"spectral_radius": 13.2, "converged_epsilon": 1e-6, "fixed_point_residual": 1e-6}
+    assert fq.record_verdict(record).startswith("not established: Newton stopped at residual 1.0e-06")
+    assert fq.record_verdict({**record, "settings": {"newton_tolerance": 1e-5}}) == "unstable"
+    assert fq.record_verdict({**record, "newton_tolerance": 1e-5}) == "unstable"
 
 
 def test_prediction_of_a_linear_map_is_exact():

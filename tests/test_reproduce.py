@@ -118,11 +118,11 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
                    "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
     # The Floquet row says of each orbit whether its multipliers establish anything.
-    from drake_biped.experiments.floquet import orbit_verdict
+    from drake_biped.analysis.floquet import record_verdict
 
     floquet_row = next(row for row in table if "Floquet" in row)
     for name, gait in summaries["floquet"]["gaits"].items():
-        assert f"({orbit_verdict(gait)})" in floquet_row, name
+        assert f"({record_verdict(gait)})" in floquet_row, name
     html = (tmp_path / "report.html").read_text()
     assert html.count("<table>") >= 8 and '<img alt="Fig. 4" src="learn/fig4_reward.png"' in html
     # The slope story's numbers come from its own record.

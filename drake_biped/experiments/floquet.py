@@ -200,16 +200,6 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     }
 
 
-def orbit_verdict(record: dict[str, Any]) -> str:
-    """What a record's multipliers establish (`fq.orbit_verdict`). `record`: floquet.json's record, or a
-    summary of it holding spectral_radius, converged_epsilon and fixed_point_residual (judged against
-    the default tolerance where it holds no settings)."""
-    default = record.get("newton_tolerance", fq.NEWTON_TOLERANCE)
-    tolerance = record.get("settings", {}).get("newton_tolerance", default)
-    return fq.orbit_verdict(record["spectral_radius"], record["converged_epsilon"], record["fixed_point_residual"],
-                            tolerance)
-
-
 def _fmt(value: float | None, spec: str = ".4g") -> str:
     return "—" if value is None else format(value, spec)
 
@@ -233,7 +223,7 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
         lines.append("No two neighbouring perturbation sizes agree: the Jacobian did not converge.")
     lines += ["", "| ε | spectral radius |", "|---|---|"]
     lines += [f"| {r['epsilon']:.1e} | {_fmt(r['spectral_radius'])} |" for r in record["epsilon_sweep"]]
-    verdict = orbit_verdict(record)
+    verdict = fq.record_verdict(record)
     verdict = f"{verdict} period-1 orbit" if verdict in ("stable", "unstable") else verdict
     lines += ["", f"**Spectral radius {record['spectral_radius']:.4f}** ({verdict}). Multipliers, largest first:",
               "", "| multiplier | modulus | mode (largest components) |", "|---|---|---|"]

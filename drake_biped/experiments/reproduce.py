@@ -300,8 +300,9 @@ class Reproduction:
                 record = floquet.run(settings, folder / name, self._client)
                 out[name] = {"window": [t1, t2], **{k: record[k] for k in (
                     "spectral_radius", "converged_epsilon", "fixed_point_residual", "multipliers", "plateau",
-                    "sampling_phase_drift")}, "newton_tolerance": record["settings"]["newton_tolerance"], "decay": {k: record["decay"][k] for k in (
-                        "predicted", "map_iterated", "continued")}, "wall_time_s": record["wall_time_s"]}
+                    "sampling_phase_drift")}, "newton_tolerance": record["settings"]["newton_tolerance"],
+                    "decay": {k: record["decay"][k] for k in ("predicted", "map_iterated", "continued")},
+                    "wall_time_s": record["wall_time_s"]}
             return {"gaits": out}
 
         return self.experiment("floquet", {"windows": {k: list(v) for k, v in windows.items()},
