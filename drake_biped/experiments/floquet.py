@@ -245,10 +245,11 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
     if d.get("continued"):
         lines.append("| walk continued | " + " | ".join(f"{v:.2e}" for v in d["continued"]) + " |")
     if record.get("sampling_phase_drift"):
+        period_ms = 1e3 * record["config"]["sim"]["control_period_s"]
         lines += ["", "The fixed point walked on without restarting the update grid drifts from itself by "
                   + ", ".join(f"{v:.1e}" for v in record["sampling_phase_drift"])
-                  + " per step: the gait's sensitivity to the phase of the 1 ms control update, which the map "
-                  "(restarted at each section) does not see."]
+                  + f" per step: the gait's sensitivity to the phase of the {period_ms:g} ms control update, "
+                  "which the map (restarted at each section) does not see."]
     lines.append("")
     return "\n".join(lines)
 
