@@ -66,9 +66,14 @@ _API = {
     "fit_return_map": "drake_biped.analysis.return_map",
     "ReturnMapFit": "drake_biped.analysis.return_map",
     "moving_average": "drake_biped.analysis.series",
+    "DrakeFailure": "drake_biped.drake_failures",
 }
 
 __all__ = ["__version__", *_API]
+
+# The functions that run Drake: pydrake raises a failed internal check (DRAKE_DEMAND) as SystemExit, which
+# `except Exception` misses; through the API it is a DrakeFailure (a RuntimeError) naming the function.
+_RUN_DRAKE = {"build_plant", "build_diagram", "run_episode", "simulate"}
 
 
 def __getattr__(name: str) -> Any:
@@ -76,6 +81,10 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'drake_biped' has no attribute {name!r}")
     value = getattr(importlib.import_module(module), name)
+    if name in _RUN_DRAKE:
+        from drake_biped.drake_failures import raising_drake_failures
+
+        value = raising_drake_failures(value)
     globals()[name] = value
     return value
 
@@ -91,6 +100,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerl
     from drake_biped.analysis.series import moving_average
     from drake_biped.controller import CpgWalkingController
     from drake_biped.diagram import BipedDiagram, build_diagram
+    from drake_biped.drake_failures import DrakeFailure
     from drake_biped.episode import EpisodeResult, Kick, StepRecord, run_episode, simulate
     from drake_biped.learners.garb import GarbLearner
     from drake_biped.model import JOINT_NAMES, ModelError, build_plant

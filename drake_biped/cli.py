@@ -692,6 +692,13 @@ def main(argv: list[str] | None = None) -> int:
         if debug:
             raise
         _exit(1, f"{prefix}: failed: {type(exc).__name__}: {_one_line(exc)} (rerun with --debug for the traceback)")
+    except SystemExit as exc:  # pydrake raises a failed check inside Drake (DRAKE_DEMAND) as SystemExit
+        from drake_biped.drake_failures import drake_failure_message, is_drake_failure
+
+        if debug or not is_drake_failure(exc):
+            raise
+        _exit(1, f"{prefix}: failed: DrakeFailure: a check inside Drake failed ({drake_failure_message(exc)}) "
+                 "(rerun with --debug for the traceback)")
     return 0
 
 

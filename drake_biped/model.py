@@ -139,16 +139,19 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
             plant.RegisterVisualGeometry(world, X, Box(0.015, 1.0, 0.001), f"ground_mark_{k}",
                                          np.array([0.25, 0.35, 0.25, 1.0]))
 
-    add_marks(-2.0, 60.0)
+    # The drawn ground runs from 5 m behind the start to 60 m past the ground's last feature (the start, or
+    # the foot of the slope), so every accepted level length (up to 1000 m) has a slope to draw after it.
+    visual_end = 60.0 + (ground.level_length_m or 0.0)
+    add_marks(-2.0, visual_end)
     if ground.level_length_m is None:
         add_plane("ground", ground.slope_rad, 0.0)
-        add_visual("ground_visual", ground.slope_rad, -5.0, 60.0, -5.0 * math.tan(ground.slope_rad))
+        add_visual("ground_visual", ground.slope_rad, -5.0, visual_end, -5.0 * math.tan(ground.slope_rad))
     else:
         # Level-then-ascending: the union of two half-spaces is exactly max(0, (x - x0) tan s).
         add_plane("ground_level", 0.0, 0.0)
         add_plane("ground_slope", ground.slope_rad, ground.level_length_m)
         add_visual("ground_level_visual", 0.0, -5.0, ground.level_length_m, 0.0)
-        add_visual("ground_slope_visual", ground.slope_rad, ground.level_length_m, 60.0, 0.0)
+        add_visual("ground_slope_visual", ground.slope_rad, ground.level_length_m, visual_end, 0.0)
 
 
 def check_layout(plant: MultibodyPlant) -> None:

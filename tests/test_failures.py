@@ -242,3 +242,69 @@ def test_a_damaged_grid_point_line_is_named_and_recomputed(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "points.jsonl, line 2: not a grid point record" in err
     assert store.read_text().count("\n") == 3  # the file is left as it is
+
+
+def _drawn_ground(ground):
+    """{name: ((x, z) of the top face's back end, (x, z) of its front end)} of the ground's visual boxes."""
+    import numpy as np
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_biped.model import add_biped
+
+    handles = add_biped(DiagramBuilder(), ground, 1e-3)
+    inspector = handles.scene_graph.model_inspector()
+    boxes = {}
+    for geometry in handles.plant.GetVisualGeometriesForBody(handles.plant.world_body()):
+        name, box, pose = inspector.GetName(geometry), inspector.GetShape(geometry), inspector.GetPoseInFrame(geometry)
+        if "mark" in name:
+            continue
+        ends = [pose.translation() + pose.rotation().matrix() @ np.array([s * box.width() / 2, 0, box.height() / 2])
+                for s in (-1, 1)]
+        boxes[name] = tuple((float(e[0]), float(e[2])) for e in ends)
+    return boxes
+
+
+@pytest.mark.parametrize("level_length", [None, 0.0, 60.5, 100.0, 1000.0])
+def test_the_drawn_ground_covers_every_accepted_level_length(level_length):
+    # It stopped at 60 m: a level part longer than that asked Drake for a Box of negative width (a crash).
+    from drake_biped.params import Ground
+
+    ground = Ground(slope_rad=0.02, level_length_m=level_length)
+    boxes = sorted(_drawn_ground(ground).values())
+    assert boxes[0][0][0] == pytest.approx(-5.0) and boxes[-1][1][0] >= (level_length or 0.0) + 60.0 - 1e-9
+    for (back, front), nxt in zip(boxes, [*boxes[1:], None]):
+        for x, z in (back, front):  # the drawn surface is the ground itself
+            assert z == pytest.approx(ground.height(x), abs=1e-9)
+        if nxt is not None:
+            assert nxt[0][0] == pytest.approx(front[0])  # no gap between the level and the sloped part
+
+
+def test_a_failed_drake_check_is_a_drake_failure_through_the_api_and_one_line_on_the_command_line(
+        tmp_path, capsys, monkeypatch):
+    """pydrake raises a failed DRAKE_DEMAND as SystemExit, which `except Exception` misses: the API, the Dask
+    episode task and the command line raise or report it as DrakeFailure (a RuntimeError) naming the call."""
+    from collections import OrderedDict
+
+    from pydrake.common import trigger_an_assertion_failure
+
+    import drake_biped as db
+    from drake_biped import episode, model
+    from drake_biped.experiments.executor import episode_task
+
+    monkeypatch.setattr(model, "_add_ground", lambda plant, ground: trigger_an_assertion_failure())
+    monkeypatch.setattr(episode._CACHE, "_entries", OrderedDict())  # no diagram built before this test
+    config = db.EpisodeConfig().override({"sim.distance_m": 0.3})
+    for name, call in (("build_plant", lambda: db.build_plant()), ("build_diagram", lambda: db.build_diagram(config)),
+                       ("run_episode", lambda: db.run_episode(config)),
+                       ("episode on a Dask worker", lambda: episode_task(config.to_dict()))):
+        with pytest.raises(db.DrakeFailure) as caught:
+            call()
+        assert isinstance(caught.value, RuntimeError)
+        assert str(caught.value) == (f"{name}: a check inside Drake failed (in trigger_an_assertion_failure(): "
+                                     "condition 'false' failed.)")
+    code, lines = run_cli(capsys, ["walk", "--distance", "0.3", "--no-animation", "--out", str(tmp_path / "w")])
+    assert code == 1
+    one_line(lines, "drake-biped walk: failed: DrakeFailure: a check inside Drake failed",
+             "trigger_an_assertion_failure()", "--debug")
+    with pytest.raises(SystemExit, match="Failure at"):  # the original, with --debug
+        main(["walk", "--distance", "0.3", "--no-animation", "--out", str(tmp_path / "w"), "--debug"])

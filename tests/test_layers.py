@@ -20,6 +20,7 @@ LAYERS = {
     "drake_biped.resources": CORE,
     "drake_biped.records": CORE,
     "drake_biped.versions": CORE,
+    "drake_biped.drake_failures": CORE,
     "drake_biped.layout": CORE,
     "drake_biped.model": CORE,
     "drake_biped.kinematics": CORE,
