@@ -7,8 +7,12 @@ import numpy as np
 
 def moving_average(x, n: int = 20) -> np.ndarray:
     """Trailing moving average over the last min(n, i + 1) values, ignoring NaNs (NaN where a window holds
-    none). n = 20 is the paper's window in Figs. 8-11."""
+    none). n = 20 is the paper's window in Figs. 8-11. ValueError unless n is an integer >= 1 and x one series."""
+    if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 1:
+        raise ValueError(f"moving_average: the window n must be an integer >= 1, got {n!r}")
     x = np.asarray(x, dtype=float)
+    if x.ndim != 1:
+        raise ValueError(f"moving_average: x must be one series (a 1-D array), got shape {x.shape}")
     ok = np.isfinite(x)
     total = np.cumsum(np.insert(np.where(ok, x, 0.0), 0, 0.0))
     count = np.cumsum(np.insert(ok, 0, False))

@@ -66,13 +66,14 @@ _API = {
     "fit_return_map": "drake_biped.analysis.return_map",
     "ReturnMapFit": "drake_biped.analysis.return_map",
     "moving_average": "drake_biped.analysis.series",
-    "DrakeFailure": "drake_biped.drake_failures",
+    "DrakeFailure": "drake_biped.api_guard",
 }
 
 __all__ = ["__version__", *_API]
 
-# The functions that run Drake: pydrake raises a failed internal check (DRAKE_DEMAND) as SystemExit, which
-# `except Exception` misses; through the API it is a DrakeFailure (a RuntimeError) naming the function.
+# The functions that run Drake, handed out through `api_guard.api_function`: a configuration of the wrong
+# type is a ParameterError naming the argument, and a failed check inside Drake (a DRAKE_DEMAND, which
+# pydrake raises as SystemExit and `except Exception` misses) is a DrakeFailure naming the function.
 _RUN_DRAKE = {"build_plant", "build_diagram", "run_episode", "simulate"}
 
 
@@ -82,9 +83,9 @@ def __getattr__(name: str) -> Any:
         raise AttributeError(f"module 'drake_biped' has no attribute {name!r}")
     value = getattr(importlib.import_module(module), name)
     if name in _RUN_DRAKE:
-        from drake_biped.drake_failures import raising_drake_failures
+        from drake_biped.api_guard import api_function
 
-        value = raising_drake_failures(value)
+        value = api_function(value)
     globals()[name] = value
     return value
 
@@ -98,9 +99,9 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerl
     from drake_biped.analysis.return_map import ReturnMapFit, fit_return_map
     from drake_biped.analysis.reward import reward
     from drake_biped.analysis.series import moving_average
+    from drake_biped.api_guard import DrakeFailure
     from drake_biped.controller import CpgWalkingController
     from drake_biped.diagram import BipedDiagram, build_diagram
-    from drake_biped.drake_failures import DrakeFailure
     from drake_biped.episode import EpisodeResult, Kick, StepRecord, run_episode, simulate
     from drake_biped.learners.garb import GarbLearner
     from drake_biped.model import JOINT_NAMES, ModelError, build_plant

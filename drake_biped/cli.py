@@ -693,7 +693,7 @@ def main(argv: list[str] | None = None) -> int:
             raise
         _exit(1, f"{prefix}: failed: {type(exc).__name__}: {_one_line(exc)} (rerun with --debug for the traceback)")
     except SystemExit as exc:  # pydrake raises a failed check inside Drake (DRAKE_DEMAND) as SystemExit
-        from drake_biped.drake_failures import drake_failure_message, is_drake_failure
+        from drake_biped.api_guard import drake_failure_message, is_drake_failure
 
         if debug or not is_drake_failure(exc):
             raise

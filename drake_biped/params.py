@@ -433,6 +433,10 @@ class EpisodeConfig(_Validated):
         `"sim.distance_m"`) or by a short name of `SHORT_NAMES` (`"u_a"`, `"kappa"`, `"t1"`, ...): the
         names the grid specs use. Applied in order; each section is validated once it is rebuilt.
         `EpisodeConfig().override({"u_a": 1.8, "window.end_s": 0.5})`"""
+        if not isinstance(values, Mapping):
+            shown = repr(values) if len(repr(values)) <= 60 else repr(values)[:57] + "..."
+            raise ParameterError(f"EpisodeConfig.override: values must be a mapping of field names to values "
+                                 f"({{'u_a': 1.8}}), got {type(values).__name__} {shown}")
         sections: dict[str, dict[str, Any]] = {}
         for name, value in values.items():
             section, attr = resolve_field(name)

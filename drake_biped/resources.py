@@ -8,6 +8,7 @@ Drake's PackageMap.
 
 from __future__ import annotations
 
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -38,6 +39,9 @@ def grid_spec_names() -> list[str]:
 
 
 def _named_or_path(value: str | Path, folder: str, suffix: str, names: list[str], what: str) -> Path:
+    if not isinstance(value, (str, os.PathLike)):
+        raise ParameterError(f"{what} {value!r}: expected a shipped name (one of {names}) or a file's path, got "
+                             f"{type(value).__name__}")
     text = str(value)
     if text in names:
         return _package_path("drake_biped", folder, text + suffix)

@@ -308,3 +308,55 @@ def test_a_failed_drake_check_is_a_drake_failure_through_the_api_and_one_line_on
              "trigger_an_assertion_failure()", "--debug")
     with pytest.raises(SystemExit, match="Failure at"):  # the original, with --debug
         main(["walk", "--distance", "0.3", "--no-animation", "--out", str(tmp_path / "w"), "--debug"])
+
+
+def _api_argument_cases():
+    import numpy as np
+
+    import drake_biped as db
+    from drake_biped.learners.registry import learner_from_state
+
+    return {  # what the API once did with these: AttributeError, KeyError, TypeError, IndexError, NaNs, numpy's own
+        "override(list)": (lambda: db.EpisodeConfig().override([("u_a", 1.0)]), db.ParameterError,
+                           "EpisodeConfig.override: values must be a mapping of field names to values ({'u_a': "
+                           "1.8}), got list [('u_a', 1.0)]"),
+        "run_episode(dict)": (lambda: db.run_episode({"sim": {"distance_m": 0.3}}), db.ParameterError,
+                              "run_episode: config must be an EpisodeConfig or None, got dict {'sim': "
+                              "{'distance_m': 0.3}}; build it with EpisodeConfig.from_dict(...)"),
+        "build_diagram(dict)": (lambda: db.build_diagram({}), db.ParameterError,
+                                "build_diagram: config must be an EpisodeConfig, got dict {}"),
+        "simulate(config=3)": (lambda: db.simulate(config=3), db.ParameterError,
+                               "simulate: config must be an EpisodeConfig, got int 3"),
+        "build_plant(dict)": (lambda: db.build_plant({"slope_rad": 0.1}), db.ParameterError,
+                              "build_plant: ground must be a Ground or None, got dict {'slope_rad': 0.1}"),
+        "load_gait(None)": (lambda: db.load_gait(None), db.ParameterError,
+                            "--params None: expected a shipped name (one of ['attracting'"),
+        "GarbLearner.from_state({})": (lambda: db.GarbLearner.from_state({}), db.ParameterError,
+                                       "GarbLearner.from_state: the state has no 'mean', 'variance'"),
+        "from_state(bad rng)": (lambda: db.GarbLearner.from_state({**db.GarbLearner().state(), "rng": 5}),
+                                db.ParameterError, "GarbLearner.from_state: the state cannot be restored"),
+        "learner_from_state(cmaes)": (lambda: learner_from_state({"learner": "cmaes"}), db.ParameterError,
+                                      "CmaesLearner.from_state: the state has no 'start'"),
+        "learner_from_state(pgpe)": (lambda: learner_from_state({"learner": "pgpe"}), db.ParameterError,
+                                     "PgpeLearner.from_state: the state has no 'mean'"),
+        "moving_average(x, -2)": (lambda: db.moving_average(np.ones(5), -2), ValueError,
+                                  "moving_average: the window n must be an integer >= 1, got -2"),
+        "moving_average(x, 0)": (lambda: db.moving_average(np.ones(5), 0), ValueError,
+                                 "moving_average: the window n must be an integer >= 1, got 0"),
+        "moving_average(2-D)": (lambda: db.moving_average(np.ones((2, 2))), ValueError,
+                                "moving_average: x must be one series (a 1-D array), got shape (2, 2)"),
+        "make_learner(seed=-1)": (lambda: db.make_learner("garb", seed=-1), db.ParameterError,
+                                  "make_learner('garb'): seed must be an integer >= 0 or None, got -1"),
+        "make_learner(cmaes, seed=1.5)": (lambda: db.make_learner("cmaes", seed=1.5), db.ParameterError,
+                                          "make_learner('cmaes'): seed must be an integer >= 0 or None, got 1.5"),
+        "PgpeLearner(seed=-3)": (lambda: db.make_learner("pgpe").__class__(seed=-3), db.ParameterError,
+                                 "PgpeLearner: seed must be an integer >= 0 or None, got -3"),
+    }
+
+
+@pytest.mark.parametrize("case", list(_api_argument_cases()))
+def test_wrong_arguments_through_the_api_raise_naming_the_argument_and_value(case):
+    make, error, text = _api_argument_cases()[case]
+    with pytest.raises(error) as caught:
+        make()
+    assert text in str(caught.value) and "\n" not in str(caught.value)

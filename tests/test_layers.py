@@ -20,7 +20,7 @@ LAYERS = {
     "drake_biped.resources": CORE,
     "drake_biped.records": CORE,
     "drake_biped.versions": CORE,
-    "drake_biped.drake_failures": CORE,
+    "drake_biped.api_guard": CORE,
     "drake_biped.layout": CORE,
     "drake_biped.model": CORE,
     "drake_biped.kinematics": CORE,
@@ -37,6 +37,7 @@ LAYERS = {
     "drake_biped.learners.cmaes": EXPERIMENTS,
     "drake_biped.learners.pgpe": EXPERIMENTS,
     "drake_biped.learners.registry": EXPERIMENTS,
+    "drake_biped.learners.common": EXPERIMENTS,
     "drake_biped.cli": CLI,
     "drake_biped.__main__": CLI,
 }

@@ -127,7 +127,7 @@ def peak_rss_mb() -> float:
 def episode_task(config: dict[str, Any], kick: dict[str, float] | None = None) -> dict[str, Any]:
     """Run one episode from an EpisodeConfig dictionary (with an optional swing-hip kick: the fields of
     drake_biped.episode.Kick); its result dictionary plus worker bookkeeping."""
-    from drake_biped.drake_failures import drake_failures_raised
+    from drake_biped.api_guard import drake_failures_raised
     from drake_biped.episode import Kick, run_episode
     from drake_biped.params import EpisodeConfig
 

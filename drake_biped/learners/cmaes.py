@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.learners.common import check_seed, restored
+
 
 class CmaesLearner:
     """CMA-ES with ask/tell one episode at a time (see the module docstring)."""
@@ -35,6 +37,7 @@ class CmaesLearner:
             raise ValueError(f"variance must be a finite number > 0, got {variance!r}")
         if popsize is not None and (not isinstance(popsize, int) or popsize < 2):
             raise ValueError(f"popsize must be an integer >= 2, got {popsize!r}")
+        seed = check_seed(seed, "CmaesLearner")
         if seed is None:
             seed = int(np.random.SeedSequence().generate_state(1)[0])
         self._start = start
@@ -113,12 +116,17 @@ class CmaesLearner:
 
     @classmethod
     def from_state(cls, state: dict[str, Any]) -> CmaesLearner:
-        learner = cls(state["start"], state["variance"], seed=int(state["seed"]), popsize=state.get("popsize"))
-        for t1, t2, r in state["history"]:
-            sample = learner.ask()
-            if not np.allclose(sample, (t1, t2), rtol=0, atol=1e-9):
-                raise ValueError("CMA-ES state: its history does not replay (another pycma version?)")
-            learner.tell(sample, r)
-        for _ in range(int(state.get("pending", 0))):  # handed out before the save, not yet told
-            learner.ask()
-        return learner
+        """The learner a `state()` was saved from; ParameterError naming what a state lacks."""
+
+        def restore(state: dict[str, Any]) -> CmaesLearner:
+            learner = cls(state["start"], state["variance"], seed=state["seed"], popsize=state.get("popsize"))
+            for t1, t2, r in state["history"]:
+                sample = learner.ask()
+                if not np.allclose(sample, (t1, t2), rtol=0, atol=1e-9):
+                    raise ValueError("CMA-ES state: its history does not replay (another pycma version?)")
+                learner.tell(sample, r)
+            for _ in range(int(state.get("pending", 0))):  # handed out before the save, not yet told
+                learner.ask()
+            return learner
+
+        return restored(cls.__name__, state, ("start", "variance", "seed", "history"), restore)

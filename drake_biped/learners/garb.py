@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.learners.common import check_seed, restored
 from drake_biped.paper import TABLE_II
 
 
@@ -83,7 +84,7 @@ class GarbLearner:
         self.trace = np.zeros(2)
         self.baseline = 0.0
         self.episodes = 0  # updates so far
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(check_seed(seed, "GarbLearner"))
 
     def sample(self) -> np.ndarray:
         """(t1, t2) for the next episode, drawn from N(mean, variance * I)."""
@@ -140,9 +141,15 @@ class GarbLearner:
 
     @classmethod
     def from_state(cls, state: dict[str, Any]) -> GarbLearner:
-        learner = cls(state["mean"], state["variance"], state["beta"], [tuple(b) for b in state["schedule"]])
-        learner.trace = np.asarray(state["trace"], dtype=float)
-        learner.baseline = float(state["baseline"])
-        learner.episodes = int(state["episodes"])
-        learner._rng.bit_generator.state = state["rng"]
-        return learner
+        """The learner a `state()` was saved from; ParameterError naming what a state lacks."""
+
+        def restore(state: dict[str, Any]) -> GarbLearner:
+            learner = cls(state["mean"], state["variance"], state["beta"], [tuple(b) for b in state["schedule"]])
+            learner.trace = np.asarray(state["trace"], dtype=float)
+            learner.baseline = float(state["baseline"])
+            learner.episodes = int(state["episodes"])
+            learner._rng.bit_generator.state = state["rng"]
+            return learner
+
+        return restored(cls.__name__, state, ("mean", "variance", "beta", "schedule", "trace", "baseline",
+                                              "episodes", "rng"), restore)

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.learners.common import check_seed, restored
+
 
 class PgpeLearner:
     """Symmetric PGPE over (t1, t2), one episode per ask/tell (see the module docstring)."""
@@ -46,7 +48,7 @@ class PgpeLearner:
         self._perturbation: np.ndarray | None = None
         self._pending: list[np.ndarray] = []  # samples of the current pair handed out, not yet told
         self._rewards: list[float] = []
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(check_seed(seed, "PgpeLearner"))
 
     def ask(self) -> np.ndarray:
         """(t1, t2) for the next episode: mean + e, then mean - e."""
@@ -103,14 +105,20 @@ class PgpeLearner:
 
     @classmethod
     def from_state(cls, state: dict[str, Any]) -> PgpeLearner:
-        learner = cls(state["mean"], 0.04, mean_rate=state["mean_rate"], sigma_rate=state["sigma_rate"])
-        learner.sigma = np.asarray(state["sigma"], dtype=float)
-        learner.baseline = state["baseline"]
-        learner.best = -math.inf if state["best"] is None else float(state["best"])
-        learner.episodes = int(state["episodes"])
-        p = state["perturbation"]
-        learner._perturbation = None if p is None else np.asarray(p, dtype=float)
-        learner._pending = [np.asarray(x, dtype=float) for x in state["pending"]]
-        learner._rewards = [float(r) for r in state["rewards"]]
-        learner._rng.bit_generator.state = state["rng"]
-        return learner
+        """The learner a `state()` was saved from; ParameterError naming what a state lacks."""
+
+        def restore(state: dict[str, Any]) -> PgpeLearner:
+            learner = cls(state["mean"], 0.04, mean_rate=state["mean_rate"], sigma_rate=state["sigma_rate"])
+            learner.sigma = np.asarray(state["sigma"], dtype=float)
+            learner.baseline = state["baseline"]
+            learner.best = -math.inf if state["best"] is None else float(state["best"])
+            learner.episodes = int(state["episodes"])
+            p = state["perturbation"]
+            learner._perturbation = None if p is None else np.asarray(p, dtype=float)
+            learner._pending = [np.asarray(x, dtype=float) for x in state["pending"]]
+            learner._rewards = [float(r) for r in state["rewards"]]
+            learner._rng.bit_generator.state = state["rng"]
+            return learner
+
+        return restored(cls.__name__, state, ("mean", "mean_rate", "sigma_rate", "sigma", "baseline", "best",
+                                              "episodes", "perturbation", "pending", "rewards", "rng"), restore)

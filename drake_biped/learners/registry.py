@@ -3,12 +3,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from drake_biped.learners.cmaes import CmaesLearner
+from drake_biped.learners.common import check_seed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.pgpe import PgpeLearner
+from drake_biped.params import ParameterError
 
 __all__ = ["LEARNERS", "learner_from_state", "make_learner", "register_learner"]
 
@@ -30,15 +32,19 @@ def make_learner(name: str, mean: Sequence[float] = (0.5, 0.5), variance: float 
     """A learner by name (see drake_biped.learners), starting at `mean` with exploration variance `variance` (s^2)."""
     try:
         cls = LEARNERS[name]
-    except KeyError:
-        raise ValueError(f"learner {name!r} is not one of {sorted(LEARNERS)}") from None
-    return cls(mean, variance, seed=seed, **options)
+    except (KeyError, TypeError):
+        raise ParameterError(f"make_learner: learner {name!r} is not one of {sorted(LEARNERS)}") from None
+    return cls(mean, variance, seed=check_seed(seed, f"make_learner({name!r})"), **options)
 
 
 def learner_from_state(state: dict[str, Any]):
     """The learner a `state()` was saved from (GARB for states that name none, as older records do)."""
+    if not isinstance(state, Mapping):
+        raise ParameterError(f"learner_from_state: expected the mapping a learner's state() returns, got "
+                             f"{type(state).__name__}")
     name = state.get("learner", "garb")
     try:
-        return LEARNERS[name].from_state(state)
-    except KeyError:
-        raise ValueError(f"learner {name!r} of a saved state is not one of {sorted(LEARNERS)}") from None
+        cls = LEARNERS[name]
+    except (KeyError, TypeError):
+        raise ParameterError(f"learner {name!r} of a saved state is not one of {sorted(LEARNERS)}") from None
+    return cls.from_state(state)
