@@ -12,6 +12,7 @@ import argparse
 import math
 import os
 import sys
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -19,7 +20,10 @@ from drake_biped.model import ModelError
 from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow
 
 
-def _number(kind: str):
+def number(kind: str):
+    """An option's type: a finite number, and for `kind` "positive" > 0, "nonnegative" >= 0 ("finite": any);
+    argparse reports a refusal as one line naming the option and the value."""
+
     def parse(text: str) -> float:
         try:
             value = float(text)
@@ -37,7 +41,9 @@ def _number(kind: str):
     return parse
 
 
-def _integer(minimum: int):
+def integer(minimum: int):
+    """An option's type: an integer >= `minimum`."""
+
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -71,27 +77,27 @@ def _out_folder(text: str) -> Path:
 
 
 _MADE: list[Path] = []  # folders --out made in this invocation
-_seed = _integer(0)
-_count = _integer(1)
+_seed = integer(0)
+_count = integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
     p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, coasting, "
                    "coasting_garb, coasting_wide, paper) or a JSON file of EpisodeConfig fields (cpg, gait, "
                    "initial, ...) or a result.json")
-    p.add_argument("--distance", type=_number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
-    p.add_argument("--max-time", type=_number("positive"),
+    p.add_argument("--distance", type=number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
+    p.add_argument("--max-time", type=number("positive"),
                    help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
-    p.add_argument("--time-step", type=_number("positive"),
+    p.add_argument("--time-step", type=number("positive"),
                    help="plant and control time step (s) (default: 0.001)")
     if slope_command:
-        p.add_argument("--slope", type=_number("finite"), required=True,
+        p.add_argument("--slope", type=number("finite"), required=True,
                        help="the ascending slope after the level part (rad, > 0)")
-        p.add_argument("--level-length", type=_number("nonnegative"), default=2.0,
+        p.add_argument("--level-length", type=number("nonnegative"), default=2.0,
                        help="level ground before the slope (m)")
     else:
-        p.add_argument("--slope", type=_number("finite"), help="ground slope (rad, > 0 ascends) (default: 0, level)")
-        p.add_argument("--level-length", type=_number("nonnegative"),
+        p.add_argument("--slope", type=number("finite"), help="ground slope (rad, > 0 ascends) (default: 0, level)")
+        p.add_argument("--level-length", type=number("nonnegative"),
                        help="level ground for this many metres, then the slope (default: none, the slope everywhere)")
     p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default: 0)")
 
@@ -387,18 +393,22 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def _steps(text: str) -> list[float]:
-    parse = _number("positive")
+    parse = number("positive")
     return [parse(t) for t in text.split(",")]
 
 
-def _windows(text: str) -> list[tuple[float, float]]:
-    parse = _number("nonnegative")
+def windows(text: str) -> list[tuple[float, float]]:
+    """An option's type: torque-free windows T1-T2 (s), comma-separated, each with 0 <= T1 < T2."""
+    parse = number("nonnegative")
     out = []
     for t in text.split(","):
         ends = t.split("-")
         if len(ends) != 2:
             raise argparse.ArgumentTypeError(f"{t!r}: a window is T1-T2 in seconds, e.g. 0.3-0.7")
-        out.append((parse(ends[0]), parse(ends[1])))  # TimeStepSettings checks t1 < t2
+        t1, t2 = parse(ends[0]), parse(ends[1])
+        if t2 <= t1:
+            raise argparse.ArgumentTypeError(f"{t!r}: T2 <= T1 is no window; give T1 < T2, e.g. 0.3-0.7")
+        out.append((t1, t2))
     return out
 
 
@@ -424,8 +434,8 @@ def _positive_list(text: str) -> list[float]:
 
 
 def _add_window_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default 0.2")
-    p.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default 0.5")
+    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default 0.2")
+    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); default 0.5")
     p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
                    "(the trial with a window and the lowest C_mt)")
 
@@ -465,6 +475,23 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def script_parser(description: str | None) -> argparse.ArgumentParser:
+    """An argument parser for a script of the toolkit (examples/) with the commands' contract: an option error
+    is one line naming the option and the value, exit code 2; every default in the help. Give its options
+    this module's types (`number("positive")`, `integer(1)`, `windows`) and run the script with `run_script`."""
+    first_line = description.strip().splitlines()[0] if description and description.strip() else None
+    return _Parser(description=first_line, formatter_class=_HelpFormatter)
+
+
+def run_script(main: Callable[[], object], prog: str | None = None) -> None:
+    """Run a script's `main()` under the commands' contract: bad input (ParameterError, ModelError) one line
+    and exit 2, a failed run one line and exit 1, Ctrl-C exit 130; the traceback with DRAKE_BIPED_DEBUG=1."""
+    prog = prog or Path(sys.argv[0]).name
+    with _failures_as_one_line(prog, os.environ.get(DEBUG_ENV, "") not in ("", "0"), "run it again",
+                               f"set {DEBUG_ENV}=1 for the traceback"):
+        main()
+
+
 RESUMABLE = ("gait-search", "learn", "compare-learners", "stability", "grid", "slope", "reproduce")
 
 
@@ -485,13 +512,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     walk = sub.add_parser("walk", help="walk one episode and write its record, figures and animation")
     _add_episode_options(walk)
-    walk.add_argument("--t1", type=_number("nonnegative"),
+    walk.add_argument("--t1", type=number("nonnegative"),
                       help="torque-free start after each step start (s); with --t2 (default: no window)")
-    walk.add_argument("--t2", type=_number("nonnegative"), help="torque-free end (s), after --t1 (default: no window)")
-    walk.add_argument("--push", type=_number("finite"), help="horizontal push on the torso (N, + forward) "
+    walk.add_argument("--t2", type=number("nonnegative"), help="torque-free end (s), after --t1 (default: no window)")
+    walk.add_argument("--push", type=number("finite"), help="horizontal push on the torso (N, + forward) "
                       "(default: none)")
-    walk.add_argument("--push-start", type=_number("nonnegative"), default=0.4, help="push start (s)")
-    walk.add_argument("--push-duration", type=_number("positive"), default=0.1, help="push duration (s)")
+    walk.add_argument("--push-start", type=number("nonnegative"), default=0.4, help="push start (s)")
+    walk.add_argument("--push-duration", type=number("positive"), default=0.1, help="push duration (s)")
     walk.add_argument("--save-trajectory", action="store_true", help="also write trajectory.npz")
     walk.add_argument("--no-animation", action="store_true", help="skip walk.html and walk.gif")
     walk.add_argument("--out", required=True, type=_out_folder, help="output folder")
@@ -499,9 +526,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     wmap = sub.add_parser("window-map", help="C_mt of a grid of torque-free windows against no window")
     _add_episode_options(wmap)
-    wmap.add_argument("--step", type=_number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
-    wmap.add_argument("--t1-max", type=_number("nonnegative"), default=0.6, help="largest start t1 (s)")
-    wmap.add_argument("--t2-max", type=_number("positive"), default=0.9, help="largest end t2 (s)")
+    wmap.add_argument("--step", type=number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
+    wmap.add_argument("--t1-max", type=number("nonnegative"), default=0.6, help="largest start t1 (s)")
+    wmap.add_argument("--t2-max", type=number("positive"), default=0.9, help="largest end t2 (s)")
     _add_cluster_options(wmap)
     wmap.add_argument("--out", required=True, type=_out_folder, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
@@ -510,7 +537,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_episode_options(search)
     search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
     search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
-    search.add_argument("--sigma", type=_number("positive"), default=0.1, help="mutation scale (default 0.1)")
+    search.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale (default 0.1)")
     search.add_argument("--mutations", choices=["default", "paper", "near_paper", "coast"], default="default",
                         help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
                              "the paper does not print: the CPG and the initiation held), 'near_paper' (those "
@@ -537,11 +564,11 @@ def build_parser() -> argparse.ArgumentParser:
     ts = sub.add_parser("time-step-study", help="C_mt, speed and step period against the time step, and the default step they choose")
     ts.add_argument("--steps", type=_steps, default=[0.00025, 0.0005, 0.001, 0.002, 0.005],
                     help="time steps (s), comma-separated (default 0.00025,0.0005,0.001,0.002,0.005)")
-    ts.add_argument("--reference", type=_number("positive"), default=0.0005, help="reference step (s), one of --steps")
-    ts.add_argument("--distance", type=_number("positive"), default=10.0, help="walk this far (m); default 10")
+    ts.add_argument("--reference", type=number("positive"), default=0.0005, help="reference step (s), one of --steps")
+    ts.add_argument("--distance", type=number("positive"), default=10.0, help="walk this far (m); default 10")
     ts.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
                     "default gait. Its own time step is replaced by each of --steps")
-    ts.add_argument("--windows", type=_windows,
+    ts.add_argument("--windows", type=windows,
                     help="the windows compared with none, T1-T2 in s, comma-separated (default "
                          "0.1-0.4,0.2-0.5,0.3-0.6,0.35-0.65,0.2-0.7)")
     _add_cluster_options(ts)
@@ -557,9 +584,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
     learn.add_argument("--trials", type=_count, default=5, help="independent trials (default 5)")
     learn.add_argument("--episodes", type=_count, default=500, help="episodes per trial (default 500)")
-    learn.add_argument("--initial-mean", type=_number("nonnegative"), nargs=2, default=[0.5, 0.5],
+    learn.add_argument("--initial-mean", type=number("nonnegative"), nargs=2, default=[0.5, 0.5],
                        metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
-    learn.add_argument("--variance", type=_number("positive"), default=0.04,
+    learn.add_argument("--variance", type=number("positive"), default=0.04,
                        help="the policy's variance per time (s^2); default 0.04 as in the paper")
     _add_resumable_run_options(learn)
     learn.set_defaults(func=cmd_learn)
@@ -579,7 +606,7 @@ def build_parser() -> argparse.ArgumentParser:
     land.add_argument("window_map", help="a window-map output folder or its window_map.json")
     land.add_argument("--variance", type=_steps, default=[0.04, 0.01, 0.0025],
                       help="policy variances (s^2), comma-separated; default 0.04,0.01,0.0025")
-    land.add_argument("--start", type=_number("nonnegative"), nargs=2, metavar=("T1", "T2"),
+    land.add_argument("--start", type=number("nonnegative"), nargs=2, metavar=("T1", "T2"),
                       help="a policy start to evaluate (default 0.5 0.5)")
     land.add_argument("--samples", type=_count, default=2000, help="Monte Carlo samples per mean (default 2000)")
     land.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
@@ -591,11 +618,11 @@ def build_parser() -> argparse.ArgumentParser:
     _add_episode_options(stab)
     _add_window_options(stab)
     stab.add_argument("--trials", type=_count, default=8, help="trials per cell (default 8)")
-    stab.add_argument("--push", type=_number("positive"), default=20.0, help="push force (N); default 20")
+    stab.add_argument("--push", type=number("positive"), default=20.0, help="push force (N); default 20")
     stab.add_argument("--floquet", action="store_true",
                       help="also the periodic orbit's Floquet multipliers without and with the window (about a "
                       "minute each on 2 cores), in the report beside the regression")
-    stab.add_argument("--spread", type=_number("nonnegative"), default=0.15,
+    stab.add_argument("--spread", type=number("nonnegative"), default=0.15,
                       help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
     _add_resumable_run_options(stab)
     stab.set_defaults(func=cmd_stability)
@@ -604,8 +631,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "with and without a torque-free period (bisection, on Dask)")
     _add_episode_options(pm)
     _add_window_options(pm)
-    pm.add_argument("--max-force", type=_number("positive"), default=200.0, help="largest push tried (N); default 200")
-    pm.add_argument("--tolerance", type=_number("positive"), default=1.0, help="bisection tolerance (N); default 1")
+    pm.add_argument("--max-force", type=number("positive"), default=200.0, help="largest push tried (N); default 200")
+    pm.add_argument("--tolerance", type=number("positive"), default=1.0, help="bisection tolerance (N); default 1")
     _add_cluster_options(pm)
     pm.add_argument("--out", required=True, type=_out_folder, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
@@ -613,8 +640,8 @@ def build_parser() -> argparse.ArgumentParser:
     fl = sub.add_parser("floquet", help="the gait's periodic orbit (Newton on the full-state step map) and its "
                         "Floquet multipliers by central differences through Drake, on Dask")
     _add_episode_options(fl)
-    fl.add_argument("--t1", type=_number("nonnegative"), help="torque-free start (s); default: the gait's window")
-    fl.add_argument("--t2", type=_number("positive"), help="torque-free end (s); default: the gait's window")
+    fl.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default: the gait's window")
+    fl.add_argument("--t2", type=number("positive"), help="torque-free end (s); default: the gait's window")
     fl.add_argument("--policy", default=None, help="a learning.json: analyse its best learned torque-free period")
     fl.add_argument("--settle-steps", type=_count, default=8,
                     help="touchdowns walked from the initiation before the search starts (default 8)")
@@ -638,7 +665,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "and does online GARB learning adapt it (Figs. 8-11), on Dask")
     _add_episode_options(sl, slope_command=True)
     _add_window_options(sl)
-    sl.add_argument("--variance", type=_number("positive"), default=0.04,
+    sl.add_argument("--variance", type=number("positive"), default=0.04,
                     help="the policy's variance (s^2) when starting from --t1/--t2; default 0.04 as in the paper "
                     "(--policy carries its own)")
     sl.add_argument("--episodes", type=_count, default=100, help="learning episodes per trial (default 100)")
@@ -673,15 +700,24 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     debug = bool(getattr(args, "debug", False)) or os.environ.get(DEBUG_ENV, "") not in ("", "0")
-    prefix = f"drake-biped {args.command}"
-    try:
+    out = getattr(args, "out", None)
+    again = ("run the same command again to resume: finished work is kept in " + str(out)
+             if args.command in RESUMABLE and out else "run the same command again")
+    with _failures_as_one_line(f"drake-biped {args.command}", debug, again):
         return args.func(args)
+    return 0  # not reached: a failure leaves by SystemExit
+
+
+@contextmanager
+def _failures_as_one_line(prefix: str, debug: bool, again: str,
+                          traceback_hint: str = "rerun with --debug for the traceback") -> Iterator[None]:
+    """The contract of `main` (and of `run_script`) around a command's work: every failure one line on
+    standard error starting with `prefix`, and its exit code."""
+    try:
+        yield
     except KeyboardInterrupt:
         if debug:
             raise
-        out = getattr(args, "out", None)
-        again = ("run the same command again to resume: finished work is kept in " + str(out)
-                 if args.command in RESUMABLE and out else "run the same command again")
         _exit(130, f"{prefix}: interrupted; {again}")
     except (ParameterError, ModelError) as exc:
         _remove_empty_made_folders()
@@ -691,15 +727,14 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # a failed run: one line, the traceback on request
         if debug:
             raise
-        _exit(1, f"{prefix}: failed: {type(exc).__name__}: {_one_line(exc)} (rerun with --debug for the traceback)")
+        _exit(1, f"{prefix}: failed: {type(exc).__name__}: {_one_line(exc)} ({traceback_hint})")
     except SystemExit as exc:  # pydrake raises a failed check inside Drake (DRAKE_DEMAND) as SystemExit
         from drake_biped.api_guard import drake_failure_message, is_drake_failure
 
         if debug or not is_drake_failure(exc):
             raise
         _exit(1, f"{prefix}: failed: DrakeFailure: a check inside Drake failed ({drake_failure_message(exc)}) "
-                 "(rerun with --debug for the traceback)")
-    return 0
+                 f"({traceback_hint})")
 
 
 def _remove_empty_made_folders() -> None:

@@ -7,11 +7,10 @@ Registered, it is made by name like the shipped ones, and `drake-biped learn --l
 (in a process that has registered it).
 """
 
-import argparse
-
 import numpy as np
 
 import drake_biped as db
+from drake_biped.cli import integer, number, run_script, script_parser  # the commands' option checks
 
 
 @db.register_learner
@@ -45,16 +44,21 @@ class OnePlusOne:
         return learner
 
 
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--episodes", type=int, default=12)
-parser.add_argument("--distance", type=float, default=10.0)
+parser = script_parser(__doc__)
+parser.add_argument("--episodes", type=integer(1), default=12)
+parser.add_argument("--distance", type=number("positive"), default=10.0, help="each episode's length (m)")
 args = parser.parse_args()
 
-base = db.EpisodeConfig().override({"sim.distance_m": args.distance})
-learner = db.make_learner("one-plus-one", mean=(0.3, 0.4), variance=0.01, seed=0)
-for episode in range(1, args.episodes + 1):
-    t1, t2 = learner.ask()
-    result = db.run_episode(base.replace(window=db.TorqueFreeWindow(max(0.0, t1), max(0.0, t2))))
-    learner.tell((t1, t2), db.reward(result.cost_of_transport, result.distance_m, args.distance))
-    print(f"episode {episode:2d}: window {t1:.3f}-{t2:.3f} s, C_mt {result.cost_of_transport or float('nan'):.4f}, "
-          f"best window so far ({learner.mean[0]:.3f}, {learner.mean[1]:.3f}), sigma {learner.sigma:.3f}")
+
+def main() -> None:
+    base = db.EpisodeConfig().override({"sim.distance_m": args.distance})
+    learner = db.make_learner("one-plus-one", mean=(0.3, 0.4), variance=0.01, seed=0)
+    for episode in range(1, args.episodes + 1):
+        t1, t2 = learner.ask()
+        result = db.run_episode(base.replace(window=db.TorqueFreeWindow(max(0.0, t1), max(0.0, t2))))
+        learner.tell((t1, t2), db.reward(result.cost_of_transport, result.distance_m, args.distance))
+        print(f"episode {episode:2d}: window {t1:.3f}-{t2:.3f} s, C_mt {result.cost_of_transport or float('nan'):.4f}, "
+              f"best window so far ({learner.mean[0]:.3f}, {learner.mean[1]:.3f}), sigma {learner.sigma:.3f}")
+
+
+run_script(main)  # a bad value is one line and exit code 2, a failed run one line and 1, as for drake-biped

@@ -7,19 +7,18 @@ toolkit must be installed on every worker. The `if __name__ == "__main__":` guar
 spawns worker processes that import this file.
 """
 
-import argparse
-
 import drake_biped as db
+from drake_biped.cli import integer, number, run_script, script_parser  # the commands' option checks
 from drake_biped.experiments.executor import dask_client, episode_task
 
 WINDOWS = [(0.0, 0.0), (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.1, 0.6), (0.2, 0.7)]
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--workers", type=int, default=None, help="local workers (default: one per core)")
+    parser = script_parser(__doc__)
+    parser.add_argument("--workers", type=integer(1), default=None, help="local workers (default: one per core)")
     parser.add_argument("--scheduler", default=None, help="a running scheduler, e.g. tcp://HOST:8786")
-    parser.add_argument("--distance", type=float, default=10.0)
+    parser.add_argument("--distance", type=number("positive"), default=10.0, help="each walk's length (m)")
     args = parser.parse_args()
 
     base = db.EpisodeConfig().override({"sim.distance_m": args.distance})
@@ -29,9 +28,11 @@ def main() -> None:
     none = results[0]["cost_of_transport"]
     for (t1, t2), r in zip(WINDOWS, results):
         label = "no window" if t2 <= t1 else f"window {t1:g}-{t2:g} s"
-        print(f"{label}: {r['distance_m']:.2f} m, fell {r['fell']}, C_mt {r['cost_of_transport']:.4f} "
-              f"({100 * (r['cost_of_transport'] / none - 1):+.1f} %), worker wall {r['task_wall_time_s']:.1f} s")
+        cmt = r["cost_of_transport"]
+        change = 100 * (cmt / none - 1) if cmt and none else float("nan")
+        print(f"{label}: {r['distance_m']:.2f} m, fell {r['fell']}, C_mt {cmt or float('nan'):.4f} "
+              f"({change:+.1f} %), worker wall {r['task_wall_time_s']:.1f} s")
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)  # a bad value is one line and exit code 2, a failed run one line and 1, as for drake-biped

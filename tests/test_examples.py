@@ -69,3 +69,37 @@ def test_custom_learner(tmp_path):
     assert len(cmt) == 4 and text.count("best window so far") == 4
     best = re.findall(r"best window so far \((\d\.\d+), (\d\.\d+)\)", text)
     assert best[0] == ("0.300", "0.400")  # the first episode walks the start itself
+
+
+BAD_ARGUMENTS = [  # (script, arguments, what the one line names); once tracebacks, or exit 0 saying nothing
+    ("walk_and_plot.py", ["--distance", "nan"], ["argument --distance", "'nan' is not a finite number"]),
+    ("walk_and_plot.py", ["--t1", "99"], ["TorqueFreeWindow.start_s = 99.0", "[0, 10]"]),
+    ("return_map.py", ["--walks", "1"], ["argument --walks", "'1' must be >= 2"]),
+    ("dask_sweep.py", ["--workers", "0"], ["argument --workers", "'0' must be >= 1"]),
+    ("dask_sweep.py", ["--scheduler", "localhost"], ["--scheduler 'localhost'", "tcp://HOST:PORT"]),
+    ("window_sweep.py", ["--windows", "abc"], ["argument --windows", "'abc': a window is T1-T2"]),
+    ("window_sweep.py", ["--windows", "0.5-0.2"], ["argument --windows", "'0.5-0.2': T2 <= T1 is no window"]),
+    ("garb_loop.py", ["--episodes", "-1"], ["argument --episodes", "'-1' must be >= 1"]),
+    ("garb_loop.py", ["--distance", "1e5"], ["SimulationParams.distance_m = 100000.0 is outside"]),
+    ("custom_learner.py", ["--episodes", "0"], ["argument --episodes", "'0' must be >= 1"]),
+]
+
+
+@pytest.mark.parametrize("script, args, expected", BAD_ARGUMENTS, ids=[f"{s} {' '.join(a)}" for s, a, _ in BAD_ARGUMENTS])
+def test_a_bad_argument_is_one_line_naming_it_with_exit_code_2(tmp_path, script, args, expected):
+    out = subprocess.run([sys.executable, str(EXAMPLES / script), *args], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=120)
+    lines = [line for line in out.stderr.splitlines() if line.strip()]
+    assert out.returncode == 2 and len(lines) == 1 and "Traceback" not in out.stderr, out.stderr
+    assert lines[0].startswith(f"{script}: error: ") and all(text in lines[0] for text in expected), lines[0]
+    assert out.stdout == "" and not any(tmp_path.iterdir())  # nothing walked, nothing written
+
+
+def test_a_failed_run_of_an_example_is_one_line_with_exit_code_1(tmp_path):
+    """Two 0.3 m walks have no touchdown to fit a return map to: the run fails, in one line."""
+    out = subprocess.run([sys.executable, str(EXAMPLES / "return_map.py"), "--walks", "2", "--distance", "0.3"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    lines = [line for line in out.stderr.splitlines() if line.strip()]
+    assert out.returncode == 1 and len(lines) == 1 and "Traceback" not in out.stderr, out.stderr
+    assert lines[0] == ("return_map.py: failed: ValueError: fit_return_map needs at least 3 pairs for a 2-D map, "
+                        "got 0 (set DRAKE_BIPED_DEBUG=1 for the traceback)")
