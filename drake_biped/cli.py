@@ -241,10 +241,13 @@ def cmd_learn(args: argparse.Namespace) -> int:
 
 def cmd_figures(args: argparse.Namespace) -> int:
     from drake_biped.analysis.figures import learning_figures
+    from drake_biped.experiments.learning import check_learning_record
     from drake_biped.records import read_json
 
     out = Path(args.dir)
-    for p in learning_figures(read_json(out / "learning.json", "figures DIR"), out):
+    path = out / "learning.json"
+    record = check_learning_record(read_json(path, "figures DIR"), f"figures DIR: {path}")
+    for p in learning_figures(record, out):
         print(f"wrote {p}")
     return 0
 
@@ -492,6 +495,23 @@ def run_script(main: Callable[[], object], prog: str | None = None) -> None:
         main()
 
 
+class _VersionAction(argparse.Action):
+    """--version: the package's version, the git commit of a source checkout and Drake's version
+    (`versions.versions()`, as every record holds them); then exit 0."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        kwargs.update(nargs=0, default=argparse.SUPPRESS)
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from drake_biped.versions import versions
+
+        v = versions()
+        print(f"drake-biped {v['drake_biped']}, git commit {v['git_commit'] or 'unknown (not a source checkout)'}, "
+              f"Drake {v['drake'] or 'unknown (no drake distribution found)'}")
+        parser.exit()
+
+
 RESUMABLE = ("gait-search", "learn", "compare-learners", "stability", "grid", "slope", "reproduce")
 
 
@@ -499,6 +519,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="drake-biped", description=__doc__.splitlines()[0],
                      epilog=f"Exit codes: 0 done, 1 a run failed, 2 bad input, 130 interrupted. --debug (or "
                      f"{DEBUG_ENV}=1) shows the traceback of a failure.")
+    parser.add_argument("--version", action=_VersionAction,
+                        help="print the package's version, its git commit and Drake's version, and exit")
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--debug", action="store_true", help=f"on a failure, show the traceback (also {DEBUG_ENV}=1)")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)

@@ -33,14 +33,24 @@ def write_atomic(path: Path, data: Any) -> None:
 
 
 def read_json(path: Path, what: str) -> Any:
-    """The JSON in `path`, or ParameterError naming `what` (the option or command that gave the path)."""
+    """The JSON in `path`, or ParameterError naming `what` (the option or command that gave the path) and the
+    file: missing, unreadable, not text, not JSON, or nested beyond what Python can parse."""
     path = Path(path)
     if not path.is_file():
         raise ParameterError(f"{what}: no such file: {path}")
     try:
-        return json.loads(path.read_text())
+        text = path.read_text()
+    except OSError as exc:
+        raise ParameterError(f"{what} {path}: cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{what} {path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    try:
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise ParameterError(f"{what} {path}: not valid JSON ({exc})") from None
+    except RecursionError:
+        raise ParameterError(f"{what} {path}: JSON nested too deeply to read (beyond Python's recursion limit); "
+                             "not a file this toolkit writes") from None
 
 
 def warn(message: str) -> None:

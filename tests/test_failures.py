@@ -360,3 +360,73 @@ def test_wrong_arguments_through_the_api_raise_naming_the_argument_and_value(cas
     with pytest.raises(error) as caught:
         make()
     assert text in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_an_unreadable_params_file_is_bad_input_naming_it(tmp_path, capsys, monkeypatch):
+    """Once exit 1 (PermissionError). chmod 000 stops everyone but root; as root the read itself is made to fail."""
+    import pathlib
+
+    params = tmp_path / "locked.json"
+    params.write_text("{}")
+    params.chmod(0)
+    try:
+        if os.geteuid() == 0:  # root reads a mode-000 file: deny the read as the kernel would for anyone else
+            read_text = pathlib.Path.read_text
+
+            def denied(self, *args, **kwargs):
+                if self == params:
+                    raise PermissionError(13, "Permission denied", str(self))
+                return read_text(self, *args, **kwargs)
+
+            monkeypatch.setattr(pathlib.Path, "read_text", denied)
+        code, lines = run_cli(capsys, ["walk", "--params", str(params), "--out", str(tmp_path / "w")])
+    finally:
+        params.chmod(0o644)
+    assert code == 2
+    one_line(lines, f"--params {params}: cannot be read (Permission denied)")
+    assert not (tmp_path / "w").exists()
+
+
+@pytest.mark.parametrize("text", ["[" * 50_000 + "]" * 50_000, '{"cpg": ' * 50_000 + "1" + "}" * 50_000])
+def test_a_params_file_nested_beyond_the_recursion_limit_is_bad_input_naming_it(tmp_path, capsys, text):
+    params = tmp_path / "deep.json"
+    params.write_text(text)
+    code, lines = run_cli(capsys, ["walk", "--params", str(params), "--out", str(tmp_path / "w")])
+    assert code == 2  # once exit 1 with "RecursionError" and no file named
+    one_line(lines, f"--params {params}: JSON nested too deeply to read")
+
+
+def test_a_params_file_that_is_not_text_is_bad_input_naming_it(tmp_path, capsys):
+    params = tmp_path / "binary.json"
+    params.write_bytes(b"\xff\xfe\x00{")
+    code, lines = run_cli(capsys, ["walk", "--params", str(params), "--out", str(tmp_path / "w")])
+    assert code == 2
+    one_line(lines, f"--params {params}: not UTF-8 text")
+
+
+@pytest.mark.parametrize("record, missing", [({"settings": {}}, "it has no 'trials' list"),
+                                             ({"trials": [{"trial": 0, "episodes": [{"reward": 1.0}]}]},
+                                              "trials[0], episode 1 has no 'cost_of_transport'"),
+                                             ([1, 2], "it holds a JSON list, not an object")])
+def test_figures_of_a_record_that_is_not_a_learning_record_names_the_file(tmp_path, capsys, record, missing):
+    (tmp_path / "learning.json").write_text(json.dumps(record))
+    code, lines = run_cli(capsys, ["figures", str(tmp_path)])
+    assert code == 2  # once exit 1 with "KeyError: 'trials'"
+    one_line(lines, f"figures DIR: {tmp_path / 'learning.json'}: not a learning record", missing)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["learning.json"]  # no figure drawn
+
+
+def test_version_prints_the_package_the_commit_and_drake(capsys):
+    from drake_biped.versions import versions
+
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    out, err = capsys.readouterr()
+    v = versions()
+    assert stop.value.code == 0 and err == ""
+    assert out == (f"drake-biped {v['drake_biped']}, git commit {v['git_commit'] or 'unknown (not a source checkout)'}, "
+                   f"Drake {v['drake']}\n")
+    assert v["drake"]  # the installed Drake's version, never "unknown" here
+    module = subprocess.run([sys.executable, "-m", "drake_biped", "--version"], capture_output=True, text=True,
+                            timeout=120)
+    assert module.returncode == 0 and module.stdout.startswith(f"drake-biped {v['drake_biped']}, git commit ")

@@ -49,7 +49,7 @@ from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
 from drake_biped.records import write_atomic
 from drake_biped.versions import versions
 
-__all__ = ["LearningSettings", "Trial", "best_learned_trial", "make_settings", "reward", "run", "run_learning",
+__all__ = ["LearningSettings", "Trial", "best_learned_trial", "check_learning_record", "make_settings", "reward", "run", "run_learning",
            "summary_lines"]
 
 RECORD_VERSION = 1
@@ -187,6 +187,37 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
         "config": config.replace(window=TorqueFreeWindow(0.0, 0.0)).to_dict(),
         "learner": learner_settings,
     }
+
+
+# What the learning figures and Table V read of each recorded episode.
+EPISODE_FIELDS = ("reward", "cost_of_transport", "fell", "t1", "t2", "mean_t1", "mean_t2")
+
+
+def check_learning_record(record: Any, source: str = "learning.json") -> dict[str, Any]:
+    """`record` when it holds what the figures are drawn from (trials, each with its number and episodes of
+    EPISODE_FIELDS, and the settings' distance); otherwise ParameterError naming `source` and what is missing."""
+
+    def refuse(what: str):
+        raise ParameterError(f"{source}: not a learning record (the learning.json of drake-biped learn): {what}")
+
+    if not isinstance(record, dict):
+        refuse(f"it holds a JSON {type(record).__name__}, not an object")
+    trials = record.get("trials")
+    if not isinstance(trials, list) or not trials:
+        refuse("it has no 'trials' list" if "trials" not in record else "its 'trials' is not a non-empty list")
+    for k, trial in enumerate(trials):
+        episodes = trial.get("episodes") if isinstance(trial, dict) else None
+        if not isinstance(episodes, list) or not episodes or "trial" not in trial:
+            refuse(f"trials[{k}] is not a trial with its number and episodes")
+        for i, episode in enumerate(episodes):
+            missing = [f for f in EPISODE_FIELDS if not isinstance(episode, dict) or f not in episode]
+            if missing:
+                refuse(f"trials[{k}], episode {i + 1} has no {', '.join(map(repr, missing))}")
+    try:
+        float(record["settings"]["config"]["sim"]["distance_m"])
+    except (KeyError, TypeError, ValueError):
+        refuse("it has no settings.config.sim.distance_m")
+    return record
 
 
 def best_learned_trial(record: dict[str, Any], source: str = "learning.json") -> dict[str, Any]:
