@@ -127,7 +127,8 @@ def _client(args: argparse.Namespace):
     """The Dask client of the cluster options: --scheduler ADDR, or a LocalCluster of --workers N."""
     from drake_biped.experiments.executor import dask_client
 
-    with dask_client(workers=args.workers, scheduler=args.scheduler) as client:  # it checks the options first
+    with dask_client(workers=args.workers, scheduler=args.scheduler,
+                     force=args.force) as client:  # it checks the options first
         yield client
 
 
@@ -341,10 +342,12 @@ def cmd_grid(args: argparse.Namespace) -> int:
     if args.spec is not None and args.points_per_axis is not None:
         raise ParameterError("give either --spec or --points-per-axis, not both")
     axes = grid.load_spec(args.spec) if args.spec is not None else grid.table_iv_axes(args.points_per_axis or 2)
+    source = f"--spec {args.spec}" if args.spec is not None else f"--points-per-axis {args.points_per_axis or 2}"
+    grid.check_size(axes, args.force, source, "--force")  # before anything is built or started
+    settings = grid.GridSettings(config, tuple(axes), force=args.force)
     out = Path(args.out)
     with _client(args) as client:
-        record = grid.run(grid.GridSettings(config, tuple(axes)), out, client, workers=args.workers,
-                          scheduler=args.scheduler)
+        record = grid.run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
     _print(grid.summary_lines(record, out))
     return 0
 
@@ -381,7 +384,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
     profile = reproduce.QUICK if args.quick else reproduce.FULL
     out = Path(args.out)
-    check_cluster_options(args.workers, args.scheduler)  # before the folder is claimed for this profile
+    check_cluster_options(args.workers, args.scheduler, args.force)  # before the folder is claimed for this profile
     reproduce.check_out(out, profile)
     hours = profile.expected_minutes / 60
     print(f"reproduce ({profile.name}): {len(reproduce.Reproduction.STEPS)} experiments into {out}/, expected "
@@ -444,8 +447,15 @@ def _add_window_options(p: argparse.ArgumentParser) -> None:
 
 
 def _add_cluster_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--workers", type=_count, default=None, help="local Dask workers (default: one per core)")
+    from drake_biped.experiments.executor import MAX_LOCAL_WORKERS_PER_CORE
+
+    p.add_argument("--workers", type=_count, default=None,
+                   help=f"local Dask workers (default: one per core; at most {MAX_LOCAL_WORKERS_PER_CORE} per core "
+                   "without --force)")
     p.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    p.add_argument("--force", action="store_true",
+                   help="run what is refused as beyond this machine: more --workers than its limit, a grid "
+                   "over its point limit")
 
 
 def _add_resumable_run_options(p: argparse.ArgumentParser) -> None:

@@ -11,6 +11,7 @@ import time
 import pytest
 
 from drake_biped.cli import main
+from drake_biped.params import ParameterError
 
 
 def run_cli(capsys, argv):
@@ -36,7 +37,9 @@ def files(tmp_path):
     for name, text in {"list.json": "[1, 2]", "section.json": '{"cpg": "fast"}', "bad.json": '{"cpg": {',
                        "unknown.json": '{"cpg": {"u_q": 1}}', "range.json": '{"cpg": {"alpha": 9}}',
                        "spec_bad.yaml": "axes: [", "spec_axis.yaml": "axes: {nope: {values: [1]}}",
-                       "notamap.json": '{"config": {}}', "a_file": "x"}.items():
+                       "notamap.json": '{"config": {}}', "a_file": "x",
+                       "spec_big.yaml": "axes: {u_a: {min: 1, max: 2, points: 400}, u_r: {min: 3, max: 5, points: 400}}"
+                       }.items():
         (tmp_path / name).write_text(text)
         f[name] = str(tmp_path / name)
     return f
@@ -95,6 +98,15 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
      ["--reference 0.003", "one of --steps"]),
     (["time-step-study", "--replot", "--out", "{tmp}/t"], ["--replot", "time_step_study.json"]),
     (["gait-search", "--sigma", "-1", "--out", "{tmp}/gs"], ["--sigma", "'-1'"]),
+    # runaway sizes, refused before anything is built or started (1000^7 points once died of memory)
+    (["grid", "--points-per-axis", "1000", "--out", "{tmp}/g"],
+     ["--points-per-axis 1000: the grid has 1,000,000,000,000,000,000,000 points (1000 x 1000 x", "limit of 20,000",
+      "--force to run it anyway"]),
+    (["grid", "--spec", "{file:spec_big.yaml}", "--out", "{tmp}/g"],
+     ["spec_big.yaml: the grid has 160,000 points (400 x 400)", "limit of 20,000", "--force"]),
+    (["learn", "--workers", "1000", "--out", "{tmp}/l"],
+     ["--workers 1000: more local worker processes than this machine holds (limit ", "per core", "--force"]),
+    (["window-map", "--workers", "100000", "--out", "{tmp}/wm"], ["--workers 100000", "--force"]),
 ]
 
 
@@ -430,3 +442,23 @@ def test_version_prints_the_package_the_commit_and_drake(capsys):
     module = subprocess.run([sys.executable, "-m", "drake_biped", "--version"], capture_output=True, text=True,
                             timeout=120)
     assert module.returncode == 0 and module.stdout.startswith(f"drake-biped {v['drake_biped']}, git commit ")
+
+
+def test_runaway_sizes_through_the_api_are_refused_unless_forced():
+    from drake_biped.experiments import executor, grid
+
+    with pytest.raises(ParameterError, match=r"GridSettings.axes: the grid has 78,125 points \(5 x 5 x 5 x 5 x 5 x 5 "
+                                             r"x 5\), more than the limit of 20,000 .* or force=True"):
+        grid.GridSettings(axes=tuple(grid.table_iv_axes(5)))
+    assert grid.point_count(grid.GridSettings(axes=tuple(grid.table_iv_axes(5)), force=True).axes) == 5**7
+    assert grid.point_count(grid.GridSettings(axes=tuple(grid.table_iv_axes(4))).axes) == 4**7  # within the limit
+    limit = executor.max_local_workers()
+    assert limit == executor.MAX_LOCAL_WORKERS_PER_CORE * (os.cpu_count() or 1)
+    executor.check_cluster_options(limit, None)
+    with pytest.raises(ParameterError, match=rf"--workers {limit + 1}: .*\(limit {limit}: "):
+        executor.check_cluster_options(limit + 1, None)
+    executor.check_cluster_options(limit + 1, None, force=True)
+    with pytest.raises(ParameterError, match="--workers 1000"):
+        with executor.dask_client(workers=1000):  # refused before a worker starts
+            pass
+

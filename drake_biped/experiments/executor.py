@@ -24,6 +24,15 @@ from drake_biped.params import ParameterError
 
 SCHEDULER_TIMEOUT = "10s"
 _ADDRESS = re.compile(r"^(tcp|tls|inproc|ucx)://[^\s/]+(:\d+)?$")
+# A local worker is one process running one CPU-bound episode at a time (a Drake diagram of its own, a few
+# hundred MB): more than this many per core only adds memory and switching. A scheduler's workers are that
+# cluster's business.
+MAX_LOCAL_WORKERS_PER_CORE = 2
+
+
+def max_local_workers() -> int:
+    """The most local workers this machine is asked to hold without --force."""
+    return MAX_LOCAL_WORKERS_PER_CORE * max(1, os.cpu_count() or 1)
 
 
 def check_scheduler_address(address: str) -> str:
@@ -33,14 +42,19 @@ def check_scheduler_address(address: str) -> str:
     return address
 
 
-def check_cluster_options(workers: int | None, scheduler: str | None) -> None:
-    """ParameterError unless the options name one cluster: --scheduler ADDR, or a local one of --workers N."""
+def check_cluster_options(workers: int | None, scheduler: str | None, force: bool = False) -> None:
+    """ParameterError unless the options name one cluster: --scheduler ADDR, or a local one of --workers N
+    that this machine can hold (at most `max_local_workers()`, unless `force`)."""
     if scheduler is not None:
         if workers is not None:
             raise ParameterError("--workers sizes the local cluster; it cannot be combined with --scheduler")
         check_scheduler_address(scheduler)
-    elif workers is not None and (not isinstance(workers, int) or workers < 1):
+    elif workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
+    elif workers is not None and workers > max_local_workers() and not force:
+        raise ParameterError(f"--workers {workers}: more local worker processes than this machine holds (limit "
+                             f"{max_local_workers()}: {MAX_LOCAL_WORKERS_PER_CORE} per core, {os.cpu_count()} "
+                             "cores); give --force (force=True) to start them anyway, or --scheduler for a cluster")
 
 
 @contextmanager
@@ -54,16 +68,17 @@ def client_or_local(client: Any = None) -> Iterator[Any]:
 
 
 @contextmanager
-def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator[Any]:
+def dask_client(workers: int | None = None, scheduler: str | None = None, force: bool = False) -> Iterator[Any]:
     """A `distributed.Client`: on `scheduler` when given, else on a LocalCluster of `workers` processes.
 
     The local cluster binds to 127.0.0.1 only, runs one thread per worker (Drake episodes are CPU-bound
-    and hold the GIL), and has no dashboard. Defaults to one worker per core.
+    and hold the GIL), and has no dashboard. Defaults to one worker per core; more than `max_local_workers()`
+    only with `force`.
     """
     from distributed import Client
 
     logging.getLogger("distributed").setLevel(logging.WARNING)
-    check_cluster_options(workers, scheduler)
+    check_cluster_options(workers, scheduler, force)
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)

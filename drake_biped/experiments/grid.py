@@ -35,7 +35,8 @@ from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError
 from drake_biped.records import warn, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["Axis", "GridSettings", "load_spec", "parse_spec", "run", "run_grid", "summary_lines", "table_iv_axes"]
+__all__ = ["MAX_GRID_POINTS", "Axis", "GridSettings", "check_size", "load_spec", "parse_spec", "point_count", "run",
+           "run_grid", "summary_lines", "table_iv_axes"]
 
 TABLE_IV = PAPER_TABLE_IV  # the grid search's ranges of the CPG parameters
 # The initiation's ranges (the paper searched it too but prints no range): from standing still with the
@@ -45,6 +46,10 @@ INITIATION_RANGES: dict[str, tuple[float, float]] = {
     "speed": (0.0, 2 * 0.175),
 }
 _SECTIONS = ("cpg", "gait", "initial", "window", "ground", "sim")
+# The most points a grid may have without force: 4 per axis of Table IV's seven (16 384 points, about a day
+# of 10 m episodes on 2 cores) fits; 5 per axis (78 125) does not. Every point is held in memory (its
+# EpisodeConfig, a few kB) before the first runs, so a grid of 1000 per axis (1e21) is refused, not built.
+MAX_GRID_POINTS = 20_000
 RESULT_FIELDS = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps",
                  "step_period_s", "steps")
 
@@ -140,6 +145,23 @@ def load_spec(path: Path | str) -> list[Axis]:
     except yaml.YAMLError as exc:
         raise ParameterError(f"--spec {path}: not valid YAML ({exc})") from None
     return parse_spec(data, f"--spec {path}")
+
+
+def point_count(axes: list[Axis] | tuple[Axis, ...]) -> int:
+    """How many points the axes span (the product of their sizes), without building them."""
+    return math.prod(len(a.values) for a in axes)
+
+
+def check_size(axes: list[Axis] | tuple[Axis, ...], force: bool = False, source: str = "GridSettings.axes",
+               insist: str = "force=True") -> None:
+    """ParameterError naming `source`, the point count and MAX_GRID_POINTS when the grid is larger, unless
+    `force`; nothing is built either way."""
+    n = point_count(axes)
+    if n > MAX_GRID_POINTS and not force:
+        sizes = " x ".join(str(len(a.values)) for a in axes)
+        raise ParameterError(f"{source}: the grid has {n:,} points ({sizes}), more than the limit of "
+                             f"{MAX_GRID_POINTS:,} (each point is an episode, all held in memory before the "
+                             f"first runs); give fewer points, or {insist} to run it anyway")
 
 
 def grid_points(axes: list[Axis]) -> list[dict[str, float]]:
@@ -282,6 +304,10 @@ class GridSettings:
 
     config: EpisodeConfig = field(default_factory=EpisodeConfig)
     axes: tuple[Axis, ...] = field(default_factory=lambda: tuple(table_iv_axes(2)))
+    force: bool = False  # run a grid of more than MAX_GRID_POINTS points
+
+    def __post_init__(self) -> None:
+        check_size(self.axes, self.force)
 
     def to_dict(self) -> dict[str, Any]:
         return {"config": self.config.to_dict(), "axes": [dataclasses.asdict(a) for a in self.axes]}
