@@ -155,6 +155,8 @@ def cmd_walk(args: argparse.Namespace) -> int:
     result = walk.run(walk.WalkSettings(config, animation=not args.no_animation,
                                         save_trajectory=args.save_trajectory), out)
     _print(walk.summary_lines(result))
+    if not args.no_animation:
+        _print(walk.animation_lines(out))
     if config.push is not None and result.duration_s <= config.push.start_s:
         print(f"note: the episode ended at {result.duration_s:.2f} s, before the push at {config.push.start_s:g} s "
               "started: it walked unpushed", file=sys.stderr)
@@ -170,6 +172,7 @@ def cmd_window_map(args: argparse.Namespace) -> int:
     with _client(args) as client:
         record = window_map.run(settings, Path(args.out), client)
     _print(window_map.summary_lines(record))
+    print(f"wrote {args.out}/window_map.json, window_map.csv, window_map.png")
     return 0
 
 

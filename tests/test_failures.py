@@ -462,3 +462,63 @@ def test_runaway_sizes_through_the_api_are_refused_unless_forced():
         with executor.dask_client(workers=1000):  # refused before a worker starts
             pass
 
+
+
+def test_a_short_walk_says_it_has_too_few_touchdowns_for_a_step_period(tmp_path, capsys):
+    # It printed "step n/a / n/a". A 0.3 m walk ends before its first touchdown.
+    assert main(["walk", "--distance", "0.3", "--no-animation", "--out", str(tmp_path / "w")]) == 0
+    out, err = capsys.readouterr()
+    first = out.splitlines()[0]
+    assert first.startswith("ended: distance: 0.30 m") and "n/a" not in first
+    assert first.endswith("0 steps, too few for a step period and length (3 touchdowns needed)")
+    assert "animation:" not in out and "Traceback" not in err
+
+
+def test_the_walk_names_its_saved_animation_not_a_meshcat_address_that_dies_with_it(caplog):
+    import logging
+
+    from drake_biped.experiments import walk
+
+    with caplog.at_level(logging.INFO, logger="drake"):
+        meshcat = walk.start_meshcat()
+    assert meshcat.web_url().startswith("http://")  # a server was started, to record the walk
+    assert not [r for r in caplog.records if "Meshcat listening" in r.getMessage()]  # and not announced
+    assert not any(isinstance(f, walk._DropMeshcatAddress) for f in logging.getLogger("drake").filters)
+    assert walk.animation_lines("out/w") == ["animation: out/w/walk.html (a standalone Meshcat recording: open it "
+                                             "in a browser, no server needed) and out/w/walk.gif"]
+
+
+@pytest.mark.parametrize("reduction, words", [(0.4489, "44.9 % lower"), (-0.001, "0.1 % higher"),
+                                              (-0.25, "25.0 % higher"), (0.0004, "the same (to 0.1 %)")])
+def test_learn_says_a_negative_saving_is_higher(tmp_path, reduction, words):
+    # It printed "-0.1 % lower".
+    from drake_biped.experiments.learning import summary_lines
+
+    (tmp_path / "table_v.md").write_text("| table |\n")
+    (tmp_path / "run.json").write_text(json.dumps({"sessions": [{"episodes": 2, "learning_wall_s": 1.0,
+                                                                 "episodes_per_min": 120.0}],
+                                                   "episodes": 2, "learning_wall_s": 1.0}))
+    base = 0.2
+    record = {"evaluation": {"no_window": {"cost_of_transport": base}, "reduction": reduction,
+                             "learned_mean_cost_of_transport": base * (1 - reduction)}}
+    line = summary_lines(record, tmp_path)[1]
+    assert line == f"C_mt without a torque-free period 0.200, with the learned ones {base * (1 - reduction):.3f}: {words}"
+
+
+def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, capsys, monkeypatch):
+    # It printed C_mt=0.22461234567890123 and no "wrote" line.
+    from contextlib import nullcontext
+
+    from drake_biped.experiments import executor, window_map
+
+    row = {"t1": 0.2, "t2": 0.5, "walked": True, "cost_of_transport": 0.12345678901234567, "cmt_change": -0.45}
+    record = {"config": {"sim": {"distance_m": 10.0}}, "windows": [row],
+              "baseline": {"walked": True, "cost_of_transport": 0.22461234567890123}}
+    monkeypatch.setattr(executor, "dask_client", lambda **kwargs: nullcontext())
+    monkeypatch.setattr(window_map, "run", lambda settings, out, client: record)
+    assert main(["window-map", "--out", str(tmp_path / "wm")]) == 0
+    out, err = capsys.readouterr()
+    assert out.splitlines() == ["no window: walked=True C_mt=0.225", "1/1 windows walk 10 m",
+                                "lowest C_mt: window (0.2, 0.5) C_mt=0.123 (-45.0 % vs no window)",
+                                f"wrote {tmp_path / 'wm'}/window_map.json, window_map.csv, window_map.png"]
+    assert err == ""

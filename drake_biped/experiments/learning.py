@@ -376,6 +376,17 @@ def check_resume(settings: dict[str, Any], out: Path) -> None:
         Trial(Path(out), k, settings)
 
 
+def saving_words(reduction: float) -> str:
+    """A fractional saving in words, to 0.1 %: "12.3 % lower", "0.1 % higher" (a negative saving costs more),
+    "the same (to 0.1 %)"."""
+    percent = round(100.0 * reduction, 1)
+    if percent > 0:
+        return f"{percent:.1f} % lower"
+    if percent < 0:
+        return f"{-percent:.1f} % higher"
+    return "the same (to 0.1 %)"
+
+
 def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     """What `drake-biped learn` prints after a run: Table V, the reduction, the run's speed."""
     ev = record["evaluation"]
@@ -383,7 +394,7 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     base = ev["no_window"]["cost_of_transport"]
     if ev.get("reduction") is not None:
         lines.append(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
-                     f"{ev['learned_mean_cost_of_transport']:.3f}: {100 * ev['reduction']:.1f} % lower")
+                     f"{ev['learned_mean_cost_of_transport']:.3f}: {saving_words(ev['reduction'])}")
     run_log = json.loads((out / "run.json").read_text())
     this = run_log["sessions"][-1]
     if this["episodes_per_min"]:

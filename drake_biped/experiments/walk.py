@@ -3,6 +3,7 @@ recording, the walk figure and GIF (`run` writes them all; `drake-biped walk` is
 
 from __future__ import annotations
 
+import logging
 import shutil
 import subprocess
 from dataclasses import dataclass, field
@@ -41,13 +42,34 @@ def export_diagram(diagram: Diagram, out_dir: Path, stem: str = "diagram", max_d
     return written
 
 
+class _DropMeshcatAddress(logging.Filter):
+    """Drake's "Meshcat listening for connections at http://..." line: the server lives only while the walk
+    records, so its address is gone when the command ends; the saved walk.html is what to open."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("Meshcat listening for connections at")
+
+
 def start_meshcat():
-    """A headless Meshcat server on a loopback port (7000 upward)."""
+    """A headless Meshcat server on a loopback port (7000 upward), used only to record the walk: its
+    address is not announced (see _DropMeshcatAddress)."""
     from pydrake.geometry import Meshcat, MeshcatParams
 
     params = MeshcatParams()
     params.host = "localhost"
-    return Meshcat(params)
+    drop = _DropMeshcatAddress()
+    logger = logging.getLogger("drake")
+    logger.addFilter(drop)
+    try:
+        return Meshcat(params)
+    finally:
+        logger.removeFilter(drop)
+
+
+def animation_lines(out: Path) -> list[str]:
+    """Where the saved animation is (the Meshcat server that recorded it ends with the walk)."""
+    return [f"animation: {Path(out) / 'walk.html'} (a standalone Meshcat recording: open it in a browser, no server "
+            f"needed) and {Path(out) / 'walk.gif'}"]
 
 
 # The recording's camera: this far in front of the walker's sagittal plane (m), this high, looking at the hip
@@ -125,11 +147,13 @@ def summary_lines(result) -> list[str]:
     status = f"FELL ({result.fall_reason})" if result.fell else f"ended: {result.termination}"
     cmt = "n/a" if result.cost_of_transport is None else f"{result.cost_of_transport:.3f}"
     cmt_kg = "n/a" if result.cost_of_transport_per_kg is None else f"{result.cost_of_transport_per_kg:.3f}"
-    period = "n/a" if result.step_period_s is None else f"{result.step_period_s:.3f} s"
-    length = "n/a" if result.step_length_m is None else f"{result.step_length_m:.3f} m"
+    if result.step_period_s is None or result.step_length_m is None:  # they need three touchdowns
+        gait = "too few for a step period and length (3 touchdowns needed)"
+    else:
+        gait = f"step {result.step_period_s:.3f} s / {result.step_length_m:.3f} m"
     return [
         f"{status}: {result.distance_m:.2f} m in {result.duration_s:.2f} s ({result.mean_speed_mps:.3f} m/s), "
-        f"{len(result.steps)} steps, step {period} / {length}",
+        f"{len(result.steps)} steps, {gait}",
         f"positive work {result.total_positive_work_j:.1f} J, C_mt {cmt} (E+/(m g d)), "
         f"{cmt_kg} J/(kg m) (paper's eq. 1)",
         f"wall {result.wall_time_s:.1f} s, real-time factor {result.real_time_factor:.2f}",

@@ -126,7 +126,8 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     baseline, rows = record["baseline"], record["windows"]
     walked = [r for r in rows if r["walked"]]
     best = min(walked, key=lambda r: r["cost_of_transport"], default=None)
-    lines = [f"no window: walked={baseline['walked']} C_mt={baseline['cost_of_transport']}",
+    cmt = "n/a" if baseline["cost_of_transport"] is None else f"{baseline['cost_of_transport']:.3f}"
+    lines = [f"no window: walked={baseline['walked']} C_mt={cmt}",
              f"{len(walked)}/{len(rows)} windows walk {record['config']['sim']['distance_m']:g} m"]
     if best is not None:
         lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
