@@ -32,6 +32,10 @@ crossing itself: where the clearance, extrapolated over the coming period, cross
 inside it, that period's torques blend the present roles' and the new roles' by the part of the period
 each holds (GaitParams.swap_timing "predicted"; "update" swaps them at the update that sees the crossing).
 tests/test_hot_path.py and tests/test_gait.py pin this down.
+
+The update's arithmetic is one compiled kernel (`control_step`, numba): Python only hands it the plant state,
+the update's own state vector (written in place) and the episode's numbers packed once per episode (`LAW`,
+`law_vector`), and turns its return code into the touchdown row and the EventStatus.
 """
 
 from __future__ import annotations
@@ -41,8 +45,20 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
-from drake_biped import cpg, gait
-from drake_biped.kinematics import TABLE_I_MASSES, LinkMasses, center_of_mass_from_legs, leg_points
+from drake_biped.cpg import advance_phase_k, output_k, phase_rate_k, swing_reference, torque_free_fraction
+from drake_biped.gait import (
+    ankle_torque_k,
+    clip,
+    hip_servo_torque_k,
+    is_touchdown_k,
+    knee_law,
+    placement_feedback_k,
+    swing_knee_torque_over_k,
+    torso_torque_k,
+    touchdown_rule,
+)
+from drake_biped.jit import njit
+from drake_biped.kinematics import TABLE_I_MASSES, LinkMasses, body_vector, center_of_mass_k, leg_points_k
 from drake_biped.layout import Field, VectorLayout
 from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
 from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
@@ -99,9 +115,8 @@ MAX_TOUCHDOWNS = 4096
 # Indices of the legs' joints: in the plant's positions and velocities (the planar base's 3 come first) and
 # in the actuation and torque vectors; a leg's knee and ankle follow its hip.
 Q_HIP = {leg: 3 + joint_index(leg, "hip") for leg in LEGS}
+Q_HIP_LEFT, Q_HIP_RIGHT = Q_HIP["left"], Q_HIP["right"]
 KNEE, ANKLE = JOINTS_OF_A_LEG.index("knee"), JOINTS_OF_A_LEG.index("ankle")
-# (stance hip, swing hip) position indices, by "the right leg is the stance leg"
-_LEG_Q = {True: (Q_HIP["right"], Q_HIP["left"]), False: (Q_HIP["left"], Q_HIP["right"])}
 
 FALL_REASONS = {
     0: "",
@@ -118,9 +133,330 @@ def touchdown_capacity(config: EpisodeConfig) -> int:
     return min(MAX_TOUCHDOWNS, int(math.ceil(config.sim.max_time_s / shortest)) + 1)
 
 
-_HIP_LIMIT = EFFORT_LIMITS_NM["hip"]
-_KNEE_LIMIT = EFFORT_LIMITS_NM["knee"]
-_ANKLE_LIMIT = EFFORT_LIMITS_NM["ankle"]
+
+# The episode's numbers as the compiled update takes them: one vector, packed by law_vector() when the
+# controller is configured (per episode), read in the kernel through the constants below.
+LAW = VectorLayout("law", (
+    Field("control_period_s", 1, "dt"),
+    Field("state_lag_s", 1, "the plant step: the state read at update time t is the state at t + lag"),
+    Field("alpha", 1, "CPG alpha"), Field("u_a", 1, "CPG u_a"), Field("u_eta", 1, "CPG u_eta"),
+    Field("u_r", 1, "CPG u_r"), Field("kappa", 1, "CPG kappa"),
+    Field("swing_amplitude_rad", 1, "alpha u_a / u_r"),
+    Field("integrated", 1, "1.0 for swing_reading 'integrated', 0.0 for 'anchored'"),
+    Field("predicted_swap", 1, "1.0 for swap_timing 'predicted', 0.0 for 'update'"),
+    Field("swing_offset_rad", 1, ""), Field("hip_kp", 1, ""), Field("hip_kd", 1, ""), Field("hip_ki", 1, ""),
+    Field("placement_gain", 1, ""), Field("placement_velocity_gain", 1, ""),
+    Field("torso_kp", 1, ""), Field("torso_kd", 1, ""), Field("torso_pitch_rad", 1, ""),
+    Field("knee_law", 7, "gait.knee_law(): the swing knee's thresholds and torques"),
+    Field("stance_knee_torque", 1, ""), Field("ankle_kp", 1, ""), Field("ankle_kd", 1, ""),
+    Field("touchdown_rule", 4, "gait.touchdown_rule(): the touchdown conditions' thresholds"),
+    Field("window_start_s", 1, "t1"), Field("window_end_s", 1, "t2"), Field("window_first_step", 1, ""),
+    Field("ground_slope_rad", 1, ""), Field("ground_tan_slope", 1, "tan of the slope"),
+    Field("ground_level_length_m", 1, "level ground before the slope (NaN: the slope everywhere)"),
+    Field("fall_hip_height_m", 1, ""), Field("fall_pitch_rad", 1, ""),
+    Field("hip_limit_nm", 1, ""), Field("knee_limit_nm", 1, ""), Field("ankle_limit_nm", 1, ""),
+))
+_o = LAW.offset
+L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("control_period_s", "state_lag_s", "alpha", "u_a",
+                                                                    "u_eta", "u_r", "kappa"))
+L_AMPLITUDE, L_INTEGRATED, L_PREDICTED, L_OFFSET = (_o(n) for n in ("swing_amplitude_rad", "integrated",
+                                                                   "predicted_swap", "swing_offset_rad"))
+L_HIP_KP, L_HIP_KD, L_HIP_KI, L_PLACE, L_PLACE_V = (_o(n) for n in ("hip_kp", "hip_kd", "hip_ki", "placement_gain",
+                                                                   "placement_velocity_gain"))
+L_TORSO_KP, L_TORSO_KD, L_TORSO_PITCH, L_KNEE, L_STANCE_KNEE = (_o(n) for n in (
+    "torso_kp", "torso_kd", "torso_pitch_rad", "knee_law", "stance_knee_torque"))
+L_ANKLE_KP, L_ANKLE_KD, L_TOUCHDOWN = _o("ankle_kp"), _o("ankle_kd"), _o("touchdown_rule")
+L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_first_step")
+L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
+L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
+L_HIP_LIMIT, L_KNEE_LIMIT, L_ANKLE_LIMIT = _o("hip_limit_nm"), _o("knee_limit_nm"), _o("ankle_limit_nm")
+del _o
+
+
+def law_vector(config: EpisodeConfig) -> np.ndarray:
+    """The LAW vector of an episode's configuration."""
+    g, c, w, ground, sim = config.gait, config.cpg, config.window, config.ground, config.sim
+    v = np.zeros(LAW.size)
+
+    def put(name: str, value) -> None:
+        v[LAW.slice(name)] = value
+
+    put("control_period_s", sim.control_period_s)
+    put("state_lag_s", sim.time_step_s)
+    for name in ("alpha", "u_a", "u_eta", "u_r", "kappa"):
+        put(name, getattr(c, name))
+    put("swing_amplitude_rad", c.swing_amplitude_rad)
+    put("integrated", 1.0 if g.swing_reading == "integrated" else 0.0)
+    put("predicted_swap", 1.0 if g.swap_timing == "predicted" else 0.0)
+    for name in ("swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain", "placement_velocity_gain",
+                 "torso_kp", "torso_kd", "torso_pitch_rad", "stance_knee_torque", "ankle_kp", "ankle_kd"):
+        put(name, getattr(g, name))
+    put("knee_law", knee_law(g))
+    put("touchdown_rule", touchdown_rule(g))
+    put("window_start_s", w.start_s)
+    put("window_end_s", w.end_s)
+    put("window_first_step", w.first_step)
+    put("ground_slope_rad", ground.slope_rad)
+    put("ground_tan_slope", math.tan(ground.slope_rad))
+    put("ground_level_length_m", math.nan if ground.level_length_m is None else ground.level_length_m)
+    put("fall_hip_height_m", sim.fall_hip_height_m)
+    put("fall_pitch_rad", sim.fall_pitch_rad)
+    put("hip_limit_nm", EFFORT_LIMITS_NM["hip"])
+    put("knee_limit_nm", EFFORT_LIMITS_NM["knee"])
+    put("ankle_limit_nm", EFFORT_LIMITS_NM["ankle"])
+    return v
+
+
+# The kernel's return code: bits for what the Python side must do after it.
+TOUCHED, FELL, DONE_BIT = 1, 2, 4
+
+# Leg points tuple (kinematics.leg_points_k): the slots the update reads.
+_KNEE_X, _KNEE_Z, _ANKLE_X, _HEEL_X, _HEEL_Z, _TOE_X, _TOE_Z, _THIGH, _FOOT = 0, 1, 2, 4, 5, 6, 7, 8, 10
+
+
+@njit
+def ground_height_k(law, x: float) -> float:
+    """params.Ground.height() from the LAW vector."""
+    level = law[L_LEVEL]
+    if level != level:  # NaN: the slope everywhere
+        return x * law[L_TAN]
+    return max(0.0, (x - level) * law[L_TAN])
+
+
+@njit
+def ground_slope_k(law, x: float) -> float:
+    """params.Ground.slope_at() from the LAW vector."""
+    level = law[L_LEVEL]
+    if level != level or x >= level:
+        return law[L_SLOPE]
+    return 0.0
+
+
+@njit
+def predicted_touchdown_k(law, s, now: float, clearance: float, c_prev: float, advance: float,
+                          stance_ankle_rate: float) -> float:
+    """The part of the coming control period before the swing foot's clearance, extrapolated linearly
+    from this update and the previous one, crosses the touchdown height, when the touchdown would be
+    confirmed at the period's end; -1 when no touchdown is predicted in it."""
+    rule = (law[L_TOUCHDOWN], law[L_TOUCHDOWN + 1], law[L_TOUCHDOWN + 2], law[L_TOUCHDOWN + 3])
+    thr = rule[1]
+    if not (math.isfinite(c_prev) and clearance > thr):
+        return -1.0
+    c_end = 2.0 * clearance - c_prev
+    if c_end >= thr:
+        return -1.0
+    dt = law[L_DT]
+    gamma_end = advance_phase_k(law[L_UR], law[L_KAPPA], s[GAMMA], stance_ankle_rate, dt)
+    if not is_touchdown_k(rule, now + dt - s[STEP_START], c_end, advance, gamma_end):
+        return -1.0
+    return (clearance - thr) / (clearance - c_end)
+
+
+@njit
+def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance: tuple, swing: tuple) -> None:
+    """The six torques over the period [now, now + dt) for the given roles, into s[TAU:], advancing
+    the CPG phase, the swing travel, the hip integrator and the gate in s."""
+    dt = law[L_DT]
+    if stance_right:
+        st_i, sw_i = Q_HIP_RIGHT, Q_HIP_LEFT
+    else:
+        st_i, sw_i = Q_HIP_LEFT, Q_HIP_RIGHT
+    px, pitch, pitch_rate = q[0], q[2], v[2]
+    # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
+    elapsed = now - s[STEP_START]
+
+    # CPG (eq. 2-3) and the swing reference.
+    gamma = advance_phase_k(law[L_UR], law[L_KAPPA], s[GAMMA], v[st_i + ANKLE], dt)
+    zeta = output_k(law[L_ALPHA], law[L_UA], law[L_UETA], gamma)
+    s[GAMMA] = gamma
+    s[TRAVEL] += dt * zeta
+    if law[L_INTEGRATED] != 0.0:
+        # Table III's zeta drives the swing as printed: the reference angle is its integral from the
+        # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
+        offset = law[L_OFFSET] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], px - stance[_ANKLE_X], v[0])
+        reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
+    else:
+        target = law[L_AMPLITUDE] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], px - stance[_ANKLE_X], v[0])
+        reference = swing_reference(gamma, s[LIFTOFF_ANGLE], target)
+    swing_rate = pitch_rate + v[sw_i]
+    angle_error = reference - swing[_THIGH]
+
+    # Torque-free gate: the servo's torque scaled by the part of the period outside the window (exactly
+    # zero for a period inside it), the integrator advanced by that part only.
+    free = 0.0
+    if s[STEP_COUNT] >= law[L_FIRST_STEP]:
+        free = torque_free_fraction(elapsed, dt, law[L_T1], law[L_T2])
+    hip_limit = law[L_HIP_LIMIT]
+    if free >= 1.0:
+        tau_swing_hip = 0.0
+    else:
+        s[INTEGRAL] += angle_error * dt * (1.0 - free)
+        tau_swing_hip = (1.0 - free) * clip(
+            hip_servo_torque_k(law[L_HIP_KP], law[L_HIP_KD], law[L_HIP_KI], angle_error, zeta - swing_rate,
+                               s[INTEGRAL]), hip_limit)
+    s[GATE] = free
+    tau_stance_hip = clip(torso_torque_k(law[L_TORSO_KP], law[L_TORSO_KD], law[L_TORSO_PITCH], pitch, pitch_rate)
+                          - tau_swing_hip, hip_limit)
+
+    a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
+    s[a_sw] = tau_swing_hip
+    s[a_st] = tau_stance_hip
+    # the swing knee's switches placed inside the period, along the state extrapolated over it
+    knee = (law[L_KNEE], law[L_KNEE + 1], law[L_KNEE + 2], law[L_KNEE + 3], law[L_KNEE + 4], law[L_KNEE + 5],
+            law[L_KNEE + 6])
+    knee_start = (gamma, q[sw_i + KNEE], swing[_THIGH])
+    knee_end = (advance_phase_k(law[L_UR], law[L_KAPPA], gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
+                swing[_THIGH] + dt * swing_rate)
+    knee_limit = law[L_KNEE_LIMIT]
+    s[a_sw + KNEE] = clip(swing_knee_torque_over_k(knee, knee_start, knee_end, 20), knee_limit)
+    s[a_st + KNEE] = clip(-law[L_STANCE_KNEE], knee_limit)
+    ankle_limit = law[L_ANKLE_LIMIT]
+    for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
+        foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
+        slope = ground_slope_k(law, leg[_ANKLE_X])
+        s[a + ANKLE] = clip(ankle_torque_k(law[L_ANKLE_KP], law[L_ANKLE_KD], leg[_FOOT], foot_rate, slope),
+                            ankle_limit)
+
+
+@njit
+def control_step(law, body, t: float, x, s, tau, row) -> int:
+    """One control update at context time t: reads the plant state x (q, v), advances the controller state
+    s (CONTROLLER_STATE) in place and writes the torques for the coming period into tau (6). Returns a
+    code of TOUCHED (a touchdown was confirmed: `row` holds its index and its TOUCHDOWN fields), FELL and
+    DONE_BIT."""
+    dt = law[L_DT]
+    now = t + law[L_LAG]  # the time of the plant state read (see "Timing")
+    s[STATE_TIME] = now
+    q, v = x[:9], x[9:]
+    q_prev = s[Q_PREV : Q_PREV + 6].copy()
+    pitch_prev = s[PREV_PITCH]
+    code = 0
+
+    # Work done by the held torques since the last update: tau is constant over the interval,
+    # so its work on each joint is exactly tau * (q_now - q_prev).
+    total = 0.0
+    for i in range(18):
+        total += x[i]
+    for i in range(6):
+        w = s[TAU + i] * (q[3 + i] - q_prev[i])
+        s[SIGNED_WORK + i] += w
+        if w > 0.0:
+            s[POSITIVE_WORK + i] += w
+        s[Q_PREV + i] = q[3 + i]
+
+    if not math.isfinite(total):  # a NaN or an infinity anywhere makes the sum non-finite
+        s[FALL] = 4.0
+        for i in range(6):
+            s[TAU + i] = 0.0
+            tau[i] = 0.0
+        return FELL
+
+    px, pz, pitch = q[0], q[1], q[2]
+    pitch_rate = v[2]
+    s[PREV_PITCH] = pitch
+    left = leg_points_k(body, px, pz, pitch, q[3], q[4], q[5])
+    right = leg_points_k(body, px, pz, pitch, q[6], q[7], q[8])
+    stance_right = s[STANCE_RIGHT] > 0.5
+    if stance_right:
+        st_i, sw_i = Q_HIP_RIGHT, Q_HIP_LEFT
+        stance, swing = right, left
+    else:
+        st_i, sw_i = Q_HIP_LEFT, Q_HIP_RIGHT
+        stance, swing = left, right
+    com_x = center_of_mass_k(body, px, pz, pitch, left, right)[0]
+    s[COM_X] = com_x
+
+    # Touchdown: swap the roles, reset the CPG phase (phase resetting), record the section state.
+    clearance = min(swing[_HEEL_Z] - ground_height_k(law, swing[_HEEL_X]),
+                    swing[_TOE_Z] - ground_height_k(law, swing[_TOE_X]))
+    advance = swing[_ANKLE_X] - stance[_ANKLE_X]
+    c_prev = s[PREV_CLEARANCE]
+    s[PREV_CLEARANCE] = clearance
+    rate_1, rate_2 = s[PREV_RATES], s[PREV_RATES + 1]
+    s[PREV_RATES + 1] = rate_1
+    s[PREV_RATES] = v[sw_i] - v[st_i]  # the section rate, were the swing foot to land now
+    rule = (law[L_TOUCHDOWN], law[L_TOUCHDOWN + 1], law[L_TOUCHDOWN + 2], law[L_TOUCHDOWN + 3])
+    touched = is_touchdown_k(rule, now - s[STEP_START], clearance, advance, s[GAMMA])
+    if touched:
+        stance_right = not stance_right
+        st_i, sw_i = sw_i, st_i
+        stance, swing = swing, stance
+        # T_n: the moment the clearance crossed the touchdown height, linearly between this update and
+        # the previous one, when the crossing is what confirmed the touchdown (otherwise this update).
+        back = 0.0
+        thr = rule[1]
+        crossed = math.isfinite(c_prev) and c_prev > thr >= clearance
+        if crossed:
+            back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * dt
+        f = back / dt  # how far back towards the previous update T_n lies
+        angle = (1.0 - f) * (q[st_i] - q[sw_i]) + f * (q_prev[st_i - 3] - q_prev[sw_i - 3])
+        if crossed and math.isfinite(rate_2):
+            # both rates were read before the foot reached the ground: extrapolate them to T_n
+            rate = rate_1 + (rate_1 - rate_2) * (1.0 - f)
+        else:
+            rate = v[st_i] - v[sw_i]
+        step_start = now - back
+        n = s[STEP_COUNT]
+        row[0] = n
+        row[1] = step_start
+        row[2] = angle
+        row[3] = rate
+        row[4] = 1.0 if stance_right else 0.0
+        row[5] = com_x
+        code |= TOUCHED
+        s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
+        s[STEP_START] = step_start
+        # the new swing thigh's world angle at T_n
+        s[LIFTOFF_ANGLE] = (1.0 - f) * swing[_THIGH] + f * (pitch_prev + q_prev[sw_i - 3])
+        s[STEP_COUNT] = n + 1.0
+        s[PREV_CLEARANCE] = math.inf  # the next swing foot's clearance is not yet known
+        s[PREV_RATES] = math.nan
+        s[PREV_RATES + 1] = math.nan
+        s[GAMMA] = advance_phase_k(law[L_UR], law[L_KAPPA], 0.0, v[st_i + ANKLE], back)  # the phase since T_n
+        s[INTEGRAL] = 0.0
+        s[TRAVEL] = back * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.5 * s[GAMMA])
+
+    # A touchdown predicted inside the coming period (the clearance extrapolated over it crosses the
+    # touchdown height) swaps the roles at its own time: the period's torques blend the present roles'
+    # and the new roles' by the part of the period each holds, so the swap's impulse is continuous in
+    # the state. The swap itself is recorded at the next update, from the crossing it then sees.
+    swap = -1.0
+    if not touched and law[L_PREDICTED] != 0.0:
+        swap = predicted_touchdown_k(law, s, now, clearance, c_prev, advance, v[st_i + ANKLE])
+    if swap >= 0.0:
+        new = s.copy()
+        new[STANCE_RIGHT] = 0.0 if stance_right else 1.0
+        new[STEP_START] = now + swap * dt
+        new[LIFTOFF_ANGLE] = stance[_THIGH] + swap * dt * (pitch_rate + v[st_i])
+        new[STEP_COUNT] = s[STEP_COUNT] + 1.0
+        # the phase and the travel from T_n: negative now, so that after the period they are the part of
+        # it after T_n
+        new[GAMMA] = -swap * dt * phase_rate_k(law[L_UR], law[L_KAPPA], v[sw_i + ANKLE])
+        new[TRAVEL] = -swap * dt * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.0)
+        new[INTEGRAL] = 0.0
+        period_torques_k(law, body, new, q, v, now, not stance_right, swing, stance)
+    period_torques_k(law, body, s, q, v, now, stance_right, stance, swing)
+    if swap >= 0.0:
+        for i in range(TAU, TAU + 6):
+            s[i] = swap * s[i] + (1.0 - swap) * new[i]
+
+    # Fall detection and the end of the episode.
+    if pz - ground_height_k(law, px) < law[L_FALL_HEIGHT]:
+        s[FALL] = 1.0
+    elif abs(pitch) > law[L_FALL_PITCH]:
+        s[FALL] = 2.0
+    elif min(left[_KNEE_Z] - ground_height_k(law, left[_KNEE_X]),
+             right[_KNEE_Z] - ground_height_k(law, right[_KNEE_X])) < 0.0:
+        s[FALL] = 3.0
+    if com_x >= s[TARGET_X]:
+        s[DONE] = 1.0
+    for i in range(6):
+        tau[i] = s[TAU + i]
+    if s[FALL] != 0.0:
+        code |= FELL
+    if s[DONE] != 0.0:
+        code |= DONE_BIT
+    return code
 
 
 class CpgWalkingController(LeafSystem):
@@ -131,6 +467,8 @@ class CpgWalkingController(LeafSystem):
         """`masses`: the model's link masses (`model.link_masses_of`), for the centre of mass."""
         super().__init__()
         self._masses = masses
+        self._body = body_vector(masses)
+        self._row = np.zeros(1 + _TD)  # the kernel's touchdown row: index, then TOUCHDOWN's fields
         # Structure: fixed for the life of the system.
         self._structure = self.structure_key(config)
         self._ground = config.ground
@@ -167,14 +505,7 @@ class CpgWalkingController(LeafSystem):
             raise ValueError("configure: this controller was built for another ground, time step, control "
                              "period, time limit or minimum step time; build a new diagram")
         self._config = config
-        self._cpg = config.cpg
-        self._gait = config.gait
-        self._window = config.window
-        self._amplitude = config.cpg.swing_amplitude_rad
-        self._integrated = config.gait.swing_reading == "integrated"
-        self._predicted_swap = config.gait.swap_timing == "predicted"
-        self._fall_height = config.sim.fall_hip_height_m
-        self._fall_pitch = config.sim.fall_pitch_rad
+        self._law = law_vector(config)
 
     def get_input_port_plant_state(self):
         """The plant state q (9), v (9) this controller reads."""
@@ -233,203 +564,21 @@ class CpgWalkingController(LeafSystem):
         rows = context.get_discrete_state(self._touchdown_group).value()[: n * _TD]
         return rows.reshape(n, _TD).copy()
 
-    def _predicted_touchdown(self, s, now: float, clearance: float, c_prev: float, advance: float,
-                             stance_ankle_rate: float):
-        """The part of the coming control period before the swing foot's clearance, extrapolated linearly
-        from this update and the previous one, crosses the touchdown height, when the touchdown would be
-        confirmed at the period's end; None when no touchdown is predicted in it."""
-        g = self._gait
-        thr = g.touchdown_height_m
-        if not (math.isfinite(c_prev) and clearance > thr):
-            return None
-        c_end = 2.0 * clearance - c_prev
-        if c_end >= thr:
-            return None
-        gamma_end = cpg.advance_phase(self._cpg, s[GAMMA], stance_ankle_rate, self._dt)
-        if not gait.is_touchdown(g, now + self._dt - s[STEP_START], c_end, advance, gamma_end):
-            return None
-        return (clearance - thr) / (clearance - c_end)
-
-    def _period_torques(self, s, q, v, now: float, stance_right: bool, stance, swing) -> None:
-        """The six torques over the period [now, now + dt) for the given roles, into s[TAU:], advancing
-        the CPG phase, the swing travel, the hip integrator and the gate in s."""
-        g = self._gait
-        dt = self._dt
-        ground = self._ground
-        st_i, sw_i = _LEG_Q[stance_right]
-        px, pitch, pitch_rate = q[0], q[2], v[2]
-        # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
-        elapsed = now - s[STEP_START]
-
-        # CPG (eq. 2-3) and the swing reference.
-        gamma = cpg.advance_phase(self._cpg, s[GAMMA], v[st_i + ANKLE], dt)
-        zeta = cpg.output(self._cpg, gamma)
-        s[GAMMA] = gamma
-        s[TRAVEL] += dt * zeta
-        if self._integrated:
-            # Table III's zeta drives the swing as printed: the reference angle is its integral from the
-            # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
-            offset = g.swing_offset_rad + gait.placement_feedback(g, px - stance.ankle_x, v[0])
-            reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
-        else:
-            target = gait.placement_target(g, self._amplitude, px - stance.ankle_x, v[0])
-            reference = cpg.swing_reference(gamma, s[LIFTOFF_ANGLE], target)
-        swing_rate = pitch_rate + v[sw_i]
-        angle_error = reference - swing.thigh_angle
-
-        # Torque-free gate: the servo's torque scaled by the part of the period outside the window (exactly
-        # zero for a period inside it), the integrator advanced by that part only.
-        free = 0.0
-        if s[STEP_COUNT] >= self._window.first_step:
-            free = cpg.torque_free_fraction(elapsed, dt, self._window.start_s, self._window.end_s)
-        if free >= 1.0:
-            tau_swing_hip = 0.0
-        else:
-            s[INTEGRAL] += angle_error * dt * (1.0 - free)
-            tau_swing_hip = (1.0 - free) * gait.clip(
-                gait.hip_servo_torque(g, angle_error, zeta - swing_rate, s[INTEGRAL]), _HIP_LIMIT
-            )
-        s[GATE] = free
-        tau_stance_hip = gait.clip(gait.torso_torque(g, pitch, pitch_rate) - tau_swing_hip, _HIP_LIMIT)
-
-        a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
-        s[a_sw] = tau_swing_hip
-        s[a_st] = tau_stance_hip
-        # the swing knee's switches placed inside the period, along the state extrapolated over it
-        knee_start = (gamma, q[sw_i + KNEE], swing.thigh_angle)
-        knee_end = (cpg.advance_phase(self._cpg, gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
-                    swing.thigh_angle + dt * swing_rate)
-        s[a_sw + KNEE] = gait.clip(gait.swing_knee_torque_over(g, knee_start, knee_end), _KNEE_LIMIT)
-        s[a_st + KNEE] = gait.clip(-g.stance_knee_torque, _KNEE_LIMIT)
-        for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
-            foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
-            slope = ground.slope_at(leg.ankle_x)
-            s[a + ANKLE] = gait.clip(gait.ankle_torque(g, leg.foot_angle, foot_rate, slope), _ANKLE_LIMIT)
-
     def _update(self, context, discrete_state):
-        t = context.get_time()
-        x = self._plant_state.Eval(context).tolist()
-        s = context.get_discrete_state(self._state_group).value().tolist()
-        g = self._gait
-        dt = self._dt
-        now = t + self._state_lag  # the time of the plant state read (see "Timing")
-        s[STATE_TIME] = now
-        q, v = x[:9], x[9:]
-        q_prev = s[Q_PREV : Q_PREV + 6]
-        pitch_prev = s[PREV_PITCH]
-
-        # Work done by the held torques since the last update: tau is constant over the interval,
-        # so its work on each joint is exactly tau * (q_now - q_prev).
-        for i in range(6):
-            w = s[TAU + i] * (q[3 + i] - q_prev[i])
-            s[SIGNED_WORK + i] += w
-            if w > 0.0:
-                s[POSITIVE_WORK + i] += w
-            s[Q_PREV + i] = q[3 + i]
-
-        if not math.isfinite(sum(x)):  # a NaN or an infinity anywhere makes the sum non-finite
-            s[FALL] = 4.0
-            s[TAU : TAU + 6] = [0.0] * 6
-            discrete_state.set_value(self._torque_group, np.array(s[TAU : TAU + 6]))
-            discrete_state.set_value(self._state_group, np.array(s))
-            return EventStatus.ReachedTermination(self, FALL_REASONS[4])
-
-        px, pz, pitch = q[0], q[1], q[2]
-        pitch_rate = v[2]
-        s[PREV_PITCH] = pitch
-        left = leg_points(px, pz, pitch, q[3], q[4], q[5])
-        right = leg_points(px, pz, pitch, q[6], q[7], q[8])
-        stance_right = s[STANCE_RIGHT] > 0.5
-        st_i, sw_i = _LEG_Q[stance_right]
-        stance, swing = (right, left) if stance_right else (left, right)
-        com_x = center_of_mass_from_legs(px, pz, pitch, left, right, self._masses)[0]
-        s[COM_X] = com_x
-
-        # Touchdown: swap the roles, reset the CPG phase (phase resetting), record the section state.
-        ground = self._ground
-        clearance = min(swing.heel_z - ground.height(swing.heel_x), swing.toe_z - ground.height(swing.toe_x))
-        advance = swing.ankle_x - stance.ankle_x
-        c_prev = s[PREV_CLEARANCE]
-        s[PREV_CLEARANCE] = clearance
-        rate_1, rate_2 = s[PREV_RATES], s[PREV_RATES + 1]
-        s[PREV_RATES + 1] = rate_1
-        s[PREV_RATES] = v[sw_i] - v[st_i]  # the section rate, were the swing foot to land now
-        touched = gait.is_touchdown(g, now - s[STEP_START], clearance, advance, s[GAMMA])
-        if touched:
-            stance_right = not stance_right
-            st_i, sw_i = sw_i, st_i
-            stance, swing = swing, stance
-            # T_n: the moment the clearance crossed the touchdown height, linearly between this update and
-            # the previous one, when the crossing is what confirmed the touchdown (otherwise this update).
-            back = 0.0
-            thr = g.touchdown_height_m
-            crossed = math.isfinite(c_prev) and c_prev > thr >= clearance
-            if crossed:
-                back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * dt
-            f = back / dt  # how far back towards the previous update T_n lies
-            angle = (1.0 - f) * (q[st_i] - q[sw_i]) + f * (q_prev[st_i - 3] - q_prev[sw_i - 3])
-            if crossed and math.isfinite(rate_2):
-                # both rates were read before the foot reached the ground: extrapolate them to T_n
-                rate = rate_1 + (rate_1 - rate_2) * (1.0 - f)
-            else:
-                rate = v[st_i] - v[sw_i]
-            step_start = now - back
-            n = int(s[STEP_COUNT])
+        # The discrete state handed to the update holds the current values; the kernel advances the
+        # controller state and the held torques in place.
+        code = control_step(self._law, self._body, context.get_time(), self._plant_state.Eval(context),
+                            discrete_state.get_mutable_value(self._state_group),
+                            discrete_state.get_mutable_value(self._torque_group), self._row)
+        if code == 0:
+            return None
+        if code & TOUCHED:
+            n = int(self._row[0])
             if n < self._capacity:
-                row = (step_start, angle, rate, 1.0 if stance_right else 0.0, com_x)
-                td = discrete_state.get_mutable_vector(self._touchdown_group)
-                for k in range(_TD):
-                    td.SetAtIndex(n * _TD + k, row[k])
-            s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
-            s[STEP_START] = step_start
-            # the new swing thigh's world angle at T_n
-            s[LIFTOFF_ANGLE] = (1.0 - f) * swing.thigh_angle + f * (pitch_prev + q_prev[sw_i - 3])
-            s[STEP_COUNT] = n + 1.0
-            s[PREV_CLEARANCE] = math.inf  # the next swing foot's clearance is not yet known
-            s[PREV_RATES : PREV_RATES + 2] = [math.nan, math.nan]
-            s[GAMMA] = cpg.advance_phase(self._cpg, 0.0, v[st_i + ANKLE], back)  # the phase since T_n
-            s[INTEGRAL] = 0.0
-            s[TRAVEL] = back * cpg.output(self._cpg, 0.5 * s[GAMMA])
-
-        # A touchdown predicted inside the coming period (the clearance extrapolated over it crosses the
-        # touchdown height) swaps the roles at its own time: the period's torques blend the present roles'
-        # and the new roles' by the part of the period each holds, so the swap's impulse is continuous in
-        # the state. The swap itself is recorded at the next update, from the crossing it then sees.
-        swap = None
-        if not touched and self._predicted_swap:
-            swap = self._predicted_touchdown(s, now, clearance, c_prev, advance, v[st_i + ANKLE])
-        if swap is not None:
-            new = s[:]
-            new[STANCE_RIGHT] = 0.0 if stance_right else 1.0
-            new[STEP_START] = now + swap * dt
-            new[LIFTOFF_ANGLE] = stance.thigh_angle + swap * dt * (pitch_rate + v[st_i])
-            new[STEP_COUNT] = s[STEP_COUNT] + 1.0
-            # the phase and the travel from T_n: negative now, so that after the period they are the part of
-            # it after T_n
-            new[GAMMA] = -swap * dt * cpg.phase_rate(self._cpg, v[sw_i + ANKLE])
-            new[TRAVEL] = -swap * dt * cpg.output(self._cpg, 0.0)
-            new[INTEGRAL] = 0.0
-            self._period_torques(new, q, v, now, not stance_right, swing, stance)
-        self._period_torques(s, q, v, now, stance_right, stance, swing)
-        if swap is not None:
-            for i in range(TAU, TAU + 6):
-                s[i] = swap * s[i] + (1.0 - swap) * new[i]
-
-        # Fall detection and the end of the episode.
-        if pz - ground.height(px) < self._fall_height:
-            s[FALL] = 1.0
-        elif abs(pitch) > self._fall_pitch:
-            s[FALL] = 2.0
-        elif min(left.knee_z - ground.height(left.knee_x), right.knee_z - ground.height(right.knee_x)) < 0.0:
-            s[FALL] = 3.0
-        if com_x >= s[TARGET_X]:
-            s[DONE] = 1.0
-
-        # Lists convert to Eigen element by element; a numpy array is copied in one go.
-        discrete_state.set_value(self._torque_group, np.array(s[TAU : TAU + 6]))
-        discrete_state.set_value(self._state_group, np.array(s))
-        if s[FALL] != 0.0:
-            return EventStatus.ReachedTermination(self, FALL_REASONS[int(s[FALL])])
-        if s[DONE] != 0.0:
+                discrete_state.get_mutable_value(self._touchdown_group)[n * _TD : (n + 1) * _TD] = self._row[1:]
+        if code & FELL:
+            fall = int(discrete_state.get_value(self._state_group)[FALL])
+            return EventStatus.ReachedTermination(self, FALL_REASONS[fall])
+        if code & DONE_BIT:
             return EventStatus.ReachedTermination(self, "distance reached")
         return None

@@ -22,6 +22,7 @@ LAYERS = {
     "drake_biped.versions": CORE,
     "drake_biped.api_guard": CORE,
     "drake_biped.layout": CORE,
+    "drake_biped.jit": CORE,
     "drake_biped.model": CORE,
     "drake_biped.kinematics": CORE,
     "drake_biped.cpg": CORE,
