@@ -228,6 +228,7 @@ def cmd_compare_learners(args: argparse.Namespace) -> int:
 
 def cmd_learn(args: argparse.Namespace) -> int:
     from drake_biped.experiments import learning
+    from drake_biped.experiments.progress import check_run_log
 
     config = _episode_config(args)
     settings = learning.LearningSettings(config, args.trials, args.episodes,
@@ -237,6 +238,7 @@ def cmd_learn(args: argparse.Namespace) -> int:
     record_settings = settings.record()  # validated before a cluster starts
     out = Path(args.out)
     learning.check_resume(record_settings, out)
+    check_run_log(out, "learn")  # before a cluster starts
     with _client(args) as client:
         record = learning.run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler)
     _print(learning.summary_lines(record, out))
@@ -340,6 +342,7 @@ def cmd_push_margin(args: argparse.Namespace) -> int:
 
 def cmd_grid(args: argparse.Namespace) -> int:
     from drake_biped.experiments import grid
+    from drake_biped.experiments.progress import check_run_log
 
     config = _episode_config(args)
     if args.spec is not None and args.points_per_axis is not None:
@@ -349,6 +352,7 @@ def cmd_grid(args: argparse.Namespace) -> int:
     grid.check_size(axes, args.force, source, "--force")  # before anything is built or started
     settings = grid.GridSettings(config, tuple(axes), force=args.force)
     out = Path(args.out)
+    check_run_log(out, "grid")  # before a cluster starts
     with _client(args) as client:
         record = grid.run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
     _print(grid.summary_lines(record, out))
@@ -357,6 +361,7 @@ def cmd_grid(args: argparse.Namespace) -> int:
 
 def cmd_slope(args: argparse.Namespace) -> int:
     from drake_biped.experiments import slope
+    from drake_biped.experiments.progress import check_run_log
 
     level = args.level_length
     args.level_length = None  # the slope ground is built by the slope settings, not by the episode options
@@ -374,6 +379,7 @@ def cmd_slope(args: argparse.Namespace) -> int:
                                        seed=config.seed)
     settings.start()  # a --policy that cannot be read is refused before a cluster starts
     out = Path(args.out)
+    check_run_log(out, "slope")
     with _client(args) as client:
         slope.run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
     print((out / "report.md").read_text())

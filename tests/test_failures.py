@@ -522,3 +522,44 @@ def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, caps
                                 "lowest C_mt: window (0.2, 0.5) C_mt=0.123 (-45.0 % vs no window)",
                                 f"wrote {tmp_path / 'wm'}/window_map.json, window_map.csv, window_map.png"]
     assert err == ""
+
+
+def test_a_run_log_belongs_to_one_command_and_another_command_is_refused_before_any_work(tmp_path, capsys):
+    """`learn` into a folder a `grid` run used merged the grid's log ("3 episodes ... over 2 sessions" for a
+    2-episode run). Each log names its command; another command's run there is refused by name."""
+    main(_learn(tmp_path))  # a real learning run: 2 episodes, one session
+    capsys.readouterr()
+    log = tmp_path / "l" / "run.json"
+    before = log.read_text()
+    assert json.loads(before)["command"] == "learn"
+    files = sorted(p.name for p in (tmp_path / "l").iterdir())
+    code, lines = run_cli(capsys, ["grid", "--spec", "tiny", "--distance", "0.5", "--workers", "1",
+                                   "--out", str(tmp_path / "l")])
+    assert code == 2
+    one_line(lines, f"{log} is the run log of drake-biped learn", "grid does not run into", "a folder of its own")
+    assert log.read_text() == before and sorted(p.name for p in (tmp_path / "l").iterdir()) == files
+    # and the other way round, through the API too: a grid's log is never a learning run's
+    from drake_biped.experiments.progress import RunProgress, SessionLog
+
+    grid_out = tmp_path / "g"
+    report = RunProgress(grid_out, None, None, "grid", "point", bar=False, command="grid")
+    report(0, 3)
+    report(3, 3)
+    report.close()
+    code, lines = run_cli(capsys, _learn(tmp_path)[:-1] + [str(grid_out)])
+    assert code == 2
+    one_line(lines, f"{grid_out / 'run.json'} is the run log of drake-biped grid", "learn does not run into")
+    assert sorted(p.name for p in grid_out.iterdir()) == ["run.json"]  # no learning record begun
+    with pytest.raises(ParameterError, match="is the run log of drake-biped grid"):
+        SessionLog(grid_out / "run.json", None, None, command="slope")
+
+
+def test_a_run_log_from_before_logs_named_their_command_is_taken_over(tmp_path):
+    from drake_biped.experiments.progress import SessionLog
+
+    path = tmp_path / "run.json"
+    path.write_text(json.dumps({"sessions": [{"episodes": 2, "learning_wall_s": 1.0, "finished": True}]}))
+    log = SessionLog(path, 1, None, command="learn", every_s=0.0)
+    log.update(1, finished=True)
+    record = json.loads(path.read_text())
+    assert record["command"] == "learn" and [s["episodes"] for s in record["sessions"]] == [2, 1]

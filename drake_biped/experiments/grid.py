@@ -321,7 +321,7 @@ def run(settings: GridSettings, out: Path, client=None, progress: bool = True,
     from drake_biped.experiments.progress import RunProgress
 
     out = Path(out)
-    report = RunProgress(out, workers, scheduler, "grid", "point", bar=progress)
+    report = RunProgress(out, workers, scheduler, "grid", "point", bar=progress, command="grid")
     try:
         with client_or_local(client) as c:
             record = run_grid(out, settings.config, list(settings.axes), c, report)

@@ -354,7 +354,7 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
     out = Path(out)
     record_settings = settings.record() if isinstance(settings, LearningSettings) else settings
     versions()  # the code version this process runs, recorded now (it is cached), not at the run's end
-    report = RunProgress(out, workers, scheduler, "learning", "episode", bar=progress)
+    report = RunProgress(out, workers, scheduler, "learning", "episode", bar=progress, command="learn")
     try:
         with client_or_local(client) as c:
             trials, new = run_learning(out, record_settings, c, report)

@@ -1,4 +1,9 @@
-"""Progress of a resumable run: a tqdm bar and the run log OUT/run.json (every session's count and wall time)."""
+"""Progress of a resumable run: a tqdm bar and the run log OUT/run.json (every session's count and wall time).
+
+A run log belongs to one command (`grid`, `learn`, `slope`), named in it: another command's run into the same
+folder is refused by name before any work (`check_run_log`), so no log counts two commands' episodes as one
+run's sessions. A log written before logs named their command is taken over by the command that resumes it.
+"""
 
 from __future__ import annotations
 
@@ -8,9 +13,30 @@ import time
 from pathlib import Path
 from typing import Any
 
+from drake_biped.params import ParameterError
 from drake_biped.records import set_aside, write_atomic
 
-__all__ = ["RunProgress", "SessionLog"]
+__all__ = ["RUN_LOG", "RunProgress", "SessionLog", "check_run_log", "run_log_command"]
+
+RUN_LOG = "run.json"
+
+
+def run_log_command(path: Path) -> str | None:
+    """The command a run log names (None: no log, an unreadable one, or one from before logs named it)."""
+    try:
+        command = json.loads(Path(path).read_text()).get("command")
+    except (OSError, json.JSONDecodeError, UnicodeDecodeError, AttributeError, RecursionError):
+        return None
+    return command if isinstance(command, str) else None
+
+
+def check_run_log(out: Path, command: str) -> None:
+    """ParameterError naming OUT/run.json and its command when another command's run log is there."""
+    path = Path(out) / RUN_LOG
+    owner = run_log_command(path)
+    if owner is not None and owner != command:
+        raise ParameterError(f"{path} is the run log of drake-biped {owner}: a run log belongs to one command, so "
+                             f"{command} does not run into {Path(out)}; give it a folder of its own")
 
 
 class SessionLog:
@@ -20,9 +46,13 @@ class SessionLog:
     Wall times live here, not in learning.json, which a resume reproduces. An unreadable log is set aside as
     run.json.broken (with a warning), never dropped."""
 
-    def __init__(self, path: Path, workers: int | None, scheduler: str | None, every_s: float = 10.0):
+    def __init__(self, path: Path, workers: int | None, scheduler: str | None, every_s: float = 10.0,
+                 command: str | None = None):
         self.path = path
+        self.command = command  # the command whose run this logs (written into the log)
         self.sessions: list[dict[str, Any]] = []
+        if command is not None:
+            check_run_log(path.parent, command)  # another command's log is refused, never merged
         if path.is_file():
             try:
                 sessions = json.loads(path.read_text())["sessions"]
@@ -71,18 +101,21 @@ class SessionLog:
             episodes_all = sum(s["episodes"] for s in done)
             wall_all = sum(s["learning_wall_s"] for s in done)
             write_atomic(self.path, {
+                **({"command": self.command} if self.command is not None else {}),
                 "sessions": done, "episodes": episodes_all, "learning_wall_s": wall_all,
                 "episodes_per_min": 60.0 * episodes_all / wall_all if episodes_all and wall_all > 0 else None})
 
 
 class RunProgress:
-    """A progress bar (when `bar` is set) and the run log OUT/run.json (`SessionLog`) of a resumable run;
-    called as progress(done, total, latest_mean_reward=None) by the run as it goes."""
+    """A progress bar (when `bar` is set) and the run log OUT/run.json (`SessionLog`) of a resumable run of
+    `command`; called as progress(done, total, latest_mean_reward=None) by the run as it goes."""
 
     def __init__(self, out: Path, workers: int | None, scheduler: str | None, desc: str, unit: str,
-                 bar: bool = True):
+                 bar: bool = True, command: str | None = None):
+        if command is not None:
+            check_run_log(out, command)  # before the folder is made or anything written
         out.mkdir(parents=True, exist_ok=True)
-        self.log = SessionLog(out / "run.json", workers, scheduler)
+        self.log = SessionLog(out / RUN_LOG, workers, scheduler, command=command)
         self.bar = None
         self._bar_args = (desc, unit) if bar else None  # the bar starts with the first report
         self.first: int | None = None

@@ -256,7 +256,7 @@ def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
     out = Path(out)
     ground = settings.ground()
     state, source = settings.start()
-    report = RunProgress(out, workers, scheduler, "slope learning", "episode", bar=progress)
+    report = RunProgress(out, workers, scheduler, "slope learning", "episode", bar=progress, command="slope")
     try:
         with client_or_local(client) as c:
             record = run_slope(out, settings.config, ground, state, source, settings.trials, settings.episodes,
