@@ -1,11 +1,18 @@
-"""Closed-loop real-time factor of two source trees of drake-biped, measured interleaved on one machine.
+"""Closed-loop real-time factor of two source trees of drake-biped, measured interleaved on one machine, and
+the ceiling a Python controller can reach.
 
     python benchmarks/compare_rtf.py BEFORE_TREE AFTER_TREE [--rounds 5] [--episodes 3] [--distance 10]
+                                     [--learning 40]
 
 Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) that walks the default gait
 `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
-Simulator.AdvanceTo; the first walk of a process also builds its diagram, which is not timed). Rounds
-alternate the trees, so a change of machine load affects both alike; the table gives medians and the ratio.
+Simulator.AdvanceTo; the first walk of a process also builds its diagram, which is not timed) and its C_mt.
+In the same round, a process of the after tree measures the ceiling on the same walk: the plant alone
+replaying the walk's logged torques (no Python during the simulation), and the plant with an empty Python
+discrete update at the control rate (the cost of calling Python at all). Rounds alternate the trees, so a
+change of machine load affects all of them alike; the table gives medians and the ratios.
+`--learning N` also times N episodes as a learning run starts them (benchmarks/bench.py learning_mix) on a
+2-worker Dask cluster, once per tree per round: episodes per minute.
 A tree is any checkout of the project (e.g. `git worktree add /tmp/before COMMIT`).
 """
 
@@ -19,20 +26,47 @@ import subprocess
 import sys
 from pathlib import Path
 
-CHILD = """
-import json, sys
+HERE = Path(__file__).resolve().parent
+
+CLOSED_LOOP = """
+import json
 from drake_biped.episode import run_episode
 from drake_biped.params import EpisodeConfig, SimulationParams
 config = EpisodeConfig(sim=SimulationParams(distance_m={distance}))
-print(json.dumps([run_episode(config).real_time_factor for _ in range({episodes})]))
+walks = [run_episode(config) for _ in range({episodes})]
+print(json.dumps({{"rtf": [w.real_time_factor for w in walks], "cmt": [w.cost_of_transport for w in walks]}}))
+"""
+
+CEILING = """
+import json, sys
+sys.path.insert(0, {bench!r})
+import bench
+from drake_biped.episode import run_episode
+config = bench.config_at(1e-3, {distance})
+ref = run_episode(config, record_trajectory=True)
+times, torques = ref.trajectory["time"], ref.trajectory["actuation"]
+end = float(times[-1])
+out = {{"plant": [], "empty": []}}
+for _ in range({episodes}):
+    out["plant"].append(end / bench.replay(config, times, torques, end)[0])
+    out["empty"].append(end / bench.replay(config, times, torques, end, bench.EmptyUpdate(1e-3))[0])
+print(json.dumps(out))
+"""
+
+LEARNING = """
+import json, sys
+sys.path.insert(0, {bench!r})
+import bench
+if __name__ == "__main__":
+    print(json.dumps(bench.learning_mix({episodes}, 2)))
 """
 
 
-def measure(tree: Path, episodes: int, distance: float) -> list[float]:
+def run_child(tree: Path, code: str) -> dict:
     env = dict(os.environ, PYTHONPATH=str(tree))
-    code = CHILD.format(episodes=episodes, distance=distance)
-    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=tree, capture_output=True, text=True,
-                         check=True)
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=tree, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise SystemExit(f"compare_rtf: the measurement in {tree} failed:\n{out.stderr[-2000:]}")
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -43,20 +77,58 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--episodes", type=int, default=3)
     p.add_argument("--distance", type=float, default=10.0)
+    p.add_argument("--learning", type=int, default=0, help="episodes of the learning mix per tree and round (0: none)")
+    p.add_argument("--json", type=Path, help="also write every sample here")
     args = p.parse_args(argv)
-    samples: dict[str, list[float]] = {"before": [], "after": []}
+    trees = {"before": args.before.resolve(), "after": args.after.resolve()}
+    rtf: dict[str, list[float]] = {"before": [], "after": []}
+    cmt: dict[str, list[float]] = {"before": [], "after": []}
+    ceiling: dict[str, list[float]] = {"plant": [], "empty": []}
+    learning: dict[str, list[float]] = {"before": [], "after": []}
+    closed = CLOSED_LOOP.format(episodes=args.episodes, distance=args.distance)
     for r in range(args.rounds):
         order = ("before", "after") if r % 2 == 0 else ("after", "before")
         for name in order:
-            samples[name] += measure(getattr(args, name), args.episodes, args.distance)
-        print(f"round {r + 1}: " + ", ".join(f"{k} {statistics.median(v):.3f}" for k, v in samples.items()),
+            got = run_child(trees[name], closed)
+            rtf[name] += got["rtf"]
+            cmt[name] += got["cmt"]
+        got = run_child(trees["after"], CEILING.format(bench=str(HERE), episodes=args.episodes, distance=args.distance))
+        for k in ceiling:
+            ceiling[k] += got[k]
+        if args.learning:
+            for name in order:
+                learning[name].append(run_child(trees[name], LEARNING.format(bench=str(HERE), episodes=args.learning))
+                                      ["episodes_per_min"])
+        print(f"round {r + 1}: " + ", ".join(f"{k} {statistics.median(v):.3f}" for k, v in {**rtf, **ceiling}.items()),
               file=sys.stderr)
-    med = {k: statistics.median(v) for k, v in samples.items()}
-    print(json.dumps({"samples": samples, "median": med, "after_over_before": med["after"] / med["before"]}))
-    print(f"| tree | episodes | median real-time factor |\n|---|---|---|\n"
-          f"| before ({args.before}) | {len(samples['before'])} | {med['before']:.3f} |\n"
-          f"| after ({args.after}) | {len(samples['after'])} | {med['after']:.3f} |\n\n"
-          f"after / before = {med['after'] / med['before']:.3f}")
+    med = {k: statistics.median(v) for k, v in {**rtf, **ceiling}.items()}
+    record = {"trees": {k: str(v) for k, v in trees.items()}, "rounds": args.rounds, "episodes": args.episodes,
+              "distance_m": args.distance, "closed_loop_rtf": rtf, "cost_of_transport": cmt, "ceiling_rtf": ceiling,
+              "learning_episodes_per_min": learning, "median": med,
+              "after_over_before": med["after"] / med["before"]}
+    if args.json:
+        args.json.write_text(json.dumps(record, indent=1) + "\n")
+    print(json.dumps({"median": med, "after_over_before": record["after_over_before"]}))
+    cmt_b, cmt_a = cmt["before"][0], cmt["after"][0]
+    lines = [
+        "| what | samples | median real-time factor | of the plant alone |",
+        "|---|---|---|---|",
+        f"| plant alone, replaying the walk's torques | {len(ceiling['plant'])} | {med['plant']:.3f} | 1.00 |",
+        f"| plant + an empty Python update at 1 kHz | {len(ceiling['empty'])} | {med['empty']:.3f} | "
+        f"{med['empty'] / med['plant']:.2f} |",
+        f"| closed loop, before ({args.before}) | {len(rtf['before'])} | {med['before']:.3f} | "
+        f"{med['before'] / med['plant']:.2f} |",
+        f"| closed loop, after ({args.after}) | {len(rtf['after'])} | {med['after']:.3f} | "
+        f"{med['after'] / med['plant']:.2f} |",
+        "",
+        f"after / before = {med['after'] / med['before']:.3f}; C_mt before {cmt_b!r}, after {cmt_a!r} "
+        f"({'identical' if cmt_b == cmt_a else f'{100 * (cmt_a / cmt_b - 1):+.4f} %'})",
+    ]
+    if args.learning:
+        lb, la = statistics.median(learning["before"]), statistics.median(learning["after"])
+        lines.append(f"learning mix on 2 workers ({args.learning} episodes): before {lb:.1f}, after {la:.1f} "
+                     f"episodes/min ({la / lb:.2f}x)")
+    print("\n".join(lines))
     return 0
 
 
