@@ -563,3 +563,21 @@ def test_a_run_log_from_before_logs_named_their_command_is_taken_over(tmp_path):
     log.update(1, finished=True)
     record = json.loads(path.read_text())
     assert record["command"] == "learn" and [s["episodes"] for s in record["sessions"]] == [2, 1]
+
+
+def test_a_failed_drake_check_in_a_dask_task_reaches_the_driver_as_a_drake_failure():
+    """On a worker, pydrake's SystemExit would end the worker, not the task: every task the experiments map
+    over the cluster (map_ordered) raises it as DrakeFailure, which the driver gets like any task error."""
+    from drake_biped.api_guard import DrakeFailure
+    from drake_biped.experiments.executor import dask_client, map_ordered
+
+    def window_row(_):  # as an experiment's task would, deep inside Drake
+        from pydrake.common import trigger_an_assertion_failure
+
+        trigger_an_assertion_failure()
+
+    with dask_client(workers=1) as client:
+        with pytest.raises(DrakeFailure, match=r"^window_row on a Dask worker: a check inside Drake failed \(in "
+                                               r"trigger_an_assertion_failure\(\): condition 'false' failed\.\)$"):
+            map_ordered(client, window_row, [0])
+        assert map_ordered(client, abs, [-2, 3]) == [2, 3]  # the worker lives on

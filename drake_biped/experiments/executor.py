@@ -139,6 +139,21 @@ def peak_rss_mb() -> float:
     return rss / 1024.0 if sys.platform != "darwin" else rss / 2**20
 
 
+class DrakeGuarded:
+    """`fn` as a Dask task: a failed check inside Drake (pydrake's SystemExit, which would end the worker, not
+    the task) is raised as DrakeFailure naming `fn`, and reaches the driver as any task error does."""
+
+    def __init__(self, fn: Callable[..., Any]):
+        self.fn = fn
+        self.__name__ = getattr(fn, "__name__", "task")  # what Dask names the task's keys by
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        from drake_biped.api_guard import drake_failures_raised
+
+        with drake_failures_raised(f"{self.__name__} on a Dask worker"):
+            return self.fn(*args, **kwargs)
+
+
 def episode_task(config: dict[str, Any], kick: dict[str, float] | None = None) -> dict[str, Any]:
     """Run one episode from an EpisodeConfig dictionary (with an optional swing-hip kick: the fields of
     drake_biped.episode.Kick); its result dictionary plus worker bookkeeping."""
@@ -198,10 +213,11 @@ def map_ordered(
     items: Sequence[Any],
     progress: Callable[[int, Any], None] | None = None,
 ) -> list[Any]:
-    """fn over items on the cluster, results in the items' order; progress(done, result) as each finishes."""
+    """fn over items on the cluster, results in the items' order; progress(done, result) as each finishes.
+    A failed check inside Drake in `fn` is a DrakeFailure (`DrakeGuarded`)."""
     from distributed import as_completed
 
-    futures = client.map(fn, list(items), pure=False)
+    futures = client.map(DrakeGuarded(fn), list(items), pure=False)
     index = {f.key: i for i, f in enumerate(futures)}
     results: list[Any] = [None] * len(futures)
     for done, future in enumerate(as_completed(futures), start=1):

@@ -70,6 +70,7 @@ class FloquetSettings:
 def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
     """A batch evaluator of the step map on `client`: the points split evenly over its workers."""
     from drake_biped.analysis.step_map import evaluate_task
+    from drake_biped.experiments.executor import DrakeGuarded
 
     workers = max(1, len(client.scheduler_info()["workers"]))
 
@@ -77,7 +78,8 @@ def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch
         points = [np.asarray(p, dtype=float).tolist() for p in points]
         size = max(1, math.ceil(len(points) / (2 * workers)))
         chunks = [points[i : i + size] for i in range(0, len(points), size)]
-        futures = [client.submit(evaluate_task, config, template, chunk, pure=False) for chunk in chunks]
+        futures = [client.submit(DrakeGuarded(evaluate_task), config, template, chunk, pure=False)
+                   for chunk in chunks]
         out = []
         for part in client.gather(futures):
             out.extend(None if y is None else np.array(y) for y in part)
@@ -129,6 +131,9 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     fixed = fq.newton_fixed_point(evaluate, z0, settings.newton_epsilon, tolerance=settings.newton_tolerance,
                                   max_iterations=settings.newton_iterations, max_halvings=8)
     z = fixed.state
+    # The map's own noise on the scale of Newton's last residual: a residual within it is a fixed point found.
+    noise = fq.evaluation_noise(evaluate, z, max(fixed.residual, settings.newton_tolerance))
+    floor = fq.newton_floor(settings.newton_tolerance, noise)
     sweep = fq.epsilon_sweep(evaluate, z, settings.epsilons)
     chosen = fq.converged_epsilon(sweep, settings.plateau_tolerance)
     index = chosen["index"] if chosen["index"] is not None else int(np.argmin(np.abs(
@@ -186,6 +191,8 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
         "dominant_modes": dominant,
         "fixed_point": {n: float(v) for n, v in zip(names, z)},
         "fixed_point_residual": fixed.residual,
+        "evaluation_noise": noise,
+        "newton_floor": floor,
         "newton_residuals": fixed.residuals,
         "newton_iterations": fixed.iterations,
         "start_residual": fixed.residuals[0],
@@ -213,7 +220,9 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
              f"Full-state step map on the mid-stance section ({len(record['coordinates'])} coordinates), "
              f"central differences through Drake. Fixed point by Newton: residual "
              f"{record['start_residual']:.2e} → **{record['fixed_point_residual']:.2e}** (relative) in "
-             f"{record['newton_iterations']} iterations.", ""]
+             f"{record['newton_iterations']} iterations"
+             + (f"; the map's own evaluation noise there {record['evaluation_noise']:.1e}, so Newton's floor "
+                f"{record['newton_floor']:.1e}." if record.get("evaluation_noise") is not None else "."), ""]
     p = record["plateau"]
     if p["epsilon"] is not None:
         lines.append(f"Converged ε = **{p['epsilon']:.1e}** (spectral radius within "

@@ -318,7 +318,10 @@ def _search_start(settings: GaitSearchSettings) -> EpisodeConfig:
 
 def _score_start(c, settings: GaitSearchSettings, start: EpisodeConfig, windows, log: Path, **extra) -> float:
     """Generation 0: score the start on the cluster and log it with the search's settings; its score."""
-    value, detail = c.submit(score, start, windows, settings.objective, settings.policy_draws, pure=False).result()
+    from drake_biped.experiments.executor import DrakeGuarded
+
+    value, detail = c.submit(DrakeGuarded(score), start, windows, settings.objective, settings.policy_draws,
+                             pure=False).result()
     _append(log, {"generation": 0, "parent": start.to_dict(), "parent_score": value, "detail": detail,
                   "seed": settings.seed, "sigma": settings.sigma, "mutations": settings.mutations,
                   "objective": settings.objective, "policy_draws": settings.policy_draws, **extra, "versions": versions()})
