@@ -581,3 +581,16 @@ def test_a_failed_drake_check_in_a_dask_task_reaches_the_driver_as_a_drake_failu
                                                r"trigger_an_assertion_failure\(\): condition 'false' failed\.\)$"):
             map_ordered(client, window_row, [0])
         assert map_ordered(client, abs, [-2, 3]) == [2, 3]  # the worker lives on
+
+
+def test_a_walk_on_a_level_part_longer_than_60_m_runs(tmp_path, capsys):
+    # The command: exit 1 with Drake's "Box(): width = -40.008" (the drawn ground stopped at 60 m).
+    out = tmp_path / "w"
+    code = main(["walk", "--slope", "0.02", "--level-length", "100", "--distance", "0.3", "--no-animation",
+                 "--out", str(out)])
+    stdout, err = capsys.readouterr()
+    assert code == 0 and "Traceback" not in err and "error" not in err and "Failure" not in err
+    assert stdout.splitlines()[-1] == f"wrote {out}/"
+    record = json.loads((out / "result.json").read_text())
+    assert record["config"]["ground"] == {"slope_rad": 0.02, "level_length_m": 100.0, "friction": 1.0}
+    assert record["termination"] == "distance" and record["distance_m"] >= 0.3
