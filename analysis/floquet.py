@@ -25,6 +25,10 @@ import scipy.linalg
 
 # Newton's default tolerance on the relative residual |P(x) - x| / |x| of the gait's fixed point.
 NEWTON_TOLERANCE = 1e-9
+# A fixed point counts as found where Newton's residual is within this many times the map's own evaluation
+# noise (evaluation_noise), when that is above NEWTON_TOLERANCE: no iterate can be told from the fixed point
+# below the noise of the map that defines it.
+NOISE_FACTOR = 10.0
 
 Batch = Callable[[Sequence[np.ndarray]], Sequence[np.ndarray | None]]
 
@@ -131,6 +135,29 @@ def newton_fixed_point(evaluate: Batch, x0: np.ndarray, epsilon: float | Sequenc
                       converged=residuals[-1] <= tolerance)
 
 
+def evaluation_noise(evaluate: Batch, x: np.ndarray, scale: float, samples: int = 3, seed: int = 0) -> float:
+    """The map's own noise at x on the relative scale `scale`, relative to |x|: the largest half second
+    difference |P(x + δ) + P(x - δ) - 2 P(x)| / (2 |x|) over `samples` random directions, |δ| = scale |x|.
+    The second difference cancels the map's linear part; a smooth map leaves its curvature, about
+    |P''| |δ|² (negligible at small scales), while a map computed through a solver with its own tolerances
+    or with events placed on a time grid leaves its noise, whatever the scale. Measured at the scale of
+    Newton's last residual, it says how far the map can be trusted there."""
+    x = np.asarray(x, dtype=float).reshape(-1)
+    rng = np.random.default_rng(seed)
+    norm = max(float(np.linalg.norm(x)), 1e-300)
+    deltas = [scale * norm * d / np.linalg.norm(d) for d in rng.standard_normal((samples, len(x)))]
+    points = [x, *(x + d for d in deltas), *(x - d for d in deltas)]
+    images = check_outputs(evaluate(points), points, len(x))
+    centre, plus, minus = images[0], images[1:1 + samples], images[1 + samples:]
+    return max(float(np.linalg.norm(p + m - 2.0 * centre)) for p, m in zip(plus, minus)) / (2.0 * norm)
+
+
+def newton_floor(tolerance: float, noise: float | None) -> float:
+    """The residual below which Newton has found the fixed point: `tolerance`, or NOISE_FACTOR times the
+    map's evaluation noise where that is larger."""
+    return max(tolerance, NOISE_FACTOR * noise) if noise is not None else tolerance
+
+
 def spectral_radius(jacobian: np.ndarray) -> float:
     return float(np.max(np.abs(np.linalg.eigvals(jacobian))))
 
@@ -231,24 +258,28 @@ def named_components(vector: np.ndarray, names: Sequence[str], count: int = 4) -
 
 
 def orbit_verdict(spectral_radius: float, converged_epsilon: float | None, fixed_point_residual: float,
-                  tolerance: float) -> str:
-    """What multipliers establish: "stable" or "unstable" where Newton reached `tolerance` (relative
-    residual) and the perturbation sweep converged; otherwise "not established" and why."""
+                  tolerance: float, noise: float | None = None) -> str:
+    """What multipliers establish: "stable" or "unstable" where Newton reached its floor (`tolerance`, or
+    NOISE_FACTOR times the map's evaluation noise `noise` where that is larger; see newton_floor) and the
+    perturbation sweep converged; otherwise "not established" and why."""
     if converged_epsilon is None:
         return "not established: the Jacobian did not converge"
-    if fixed_point_residual > tolerance:
-        return f"not established: Newton stopped at residual {fixed_point_residual:.1e}, above {tolerance:.0e}"
+    floor = newton_floor(tolerance, noise)
+    if fixed_point_residual > floor:
+        why = (f"{NOISE_FACTOR:g} x the map's evaluation noise {noise:.1e}" if floor > tolerance
+               else "the tolerance")
+        return f"not established: Newton stopped at residual {fixed_point_residual:.1e}, above {floor:.1e} ({why})"
     return "stable" if spectral_radius < 1 else "unstable"
 
 
 def record_verdict(record: dict[str, Any]) -> str:
     """`orbit_verdict` of a Floquet record (floquet.json's), or of a summary holding its spectral_radius,
-    converged_epsilon, fixed_point_residual and newton_tolerance (NEWTON_TOLERANCE where it holds neither
-    that nor the record's settings)."""
+    converged_epsilon, fixed_point_residual, evaluation_noise (none: the tolerance alone) and newton_tolerance
+    (NEWTON_TOLERANCE where it holds neither that nor the record's settings)."""
     default = record.get("newton_tolerance", NEWTON_TOLERANCE)
     tolerance = record.get("settings", {}).get("newton_tolerance", default)
     return orbit_verdict(record["spectral_radius"], record["converged_epsilon"], record["fixed_point_residual"],
-                         tolerance)
+                         tolerance, record.get("evaluation_noise"))
 
 
 def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) -> np.ndarray:

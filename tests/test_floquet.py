@@ -74,12 +74,44 @@ def test_the_orbit_verdict_needs_newton_and_the_sweep_to_have_converged():
     # a Jacobian with no plateau, or one taken where Newton stopped short of a fixed point, decides nothing
     assert fq.orbit_verdict(104.0, None, 1e-10, 1e-9) == "not established: the Jacobian did not converge"
     assert fq.orbit_verdict(0.4, 1e-6, 5.1e-3, 1e-9) == ("not established: Newton stopped at residual 5.1e-03, "
-                                                         "above 1e-09")
+                                                         "above 1.0e-09 (the tolerance)")
+    # a residual at the map's own noise is a fixed point found; one far above it is not
+    assert fq.orbit_verdict(10.652, 1e-6, 1.6e-9, 1e-9, noise=4e-10) == "unstable"
+    assert fq.orbit_verdict(10.652, 1e-6, 5.1e-3, 1e-9, noise=4e-10) == (
+        "not established: Newton stopped at residual 5.1e-03, above 4.0e-09 (10 x the map's evaluation noise 4.0e-10)")
+    assert fq.orbit_verdict(0.4, 1e-6, 5e-10, 1e-9, noise=1e-14) == "stable"  # a quiet map: the tolerance rules
     # a record is judged against its own settings' tolerance, a summary against the one it holds
     record = {"spectral_radius": 13.2, "converged_epsilon": 1e-6, "fixed_point_residual": 1e-6}
     assert fq.record_verdict(record).startswith("not established: Newton stopped at residual 1.0e-06")
     assert fq.record_verdict({**record, "settings": {"newton_tolerance": 1e-5}}) == "unstable"
     assert fq.record_verdict({**record, "newton_tolerance": 1e-5}) == "unstable"
+    assert fq.record_verdict({**record, "evaluation_noise": 2e-7}) == "unstable"
+
+
+def test_evaluation_noise_measures_a_maps_own_noise_and_newton_stops_there():
+    """A map with chosen eigenvalues plus a deterministic roughness of known size (the noise of a solver's
+    tolerance, of events on a time grid): the measured noise is of that size, a smooth map's far below it,
+    and Newton, told to stop at the floor, stops within it instead of running out of iterations."""
+    step, a, x_star = _chosen_map()
+    roughness = 1e-8
+
+    def rough(x):
+        return step(x) + roughness * np.sin(1e9 * x)  # varies on the scale of 1e-9: noise to any ε above it
+
+    size = np.linalg.norm(x_star)
+    noise = fq.evaluation_noise(fq.serial(rough), x_star, 1e-7)
+    assert 0.05 * roughness / size < noise < 2 * np.sqrt(len(x_star)) * roughness / size  # 4 rough components
+    assert fq.evaluation_noise(fq.serial(step), x_star, 1e-7) < 1e-3 * roughness / size  # curvature only
+    # Newton asked for 1e-12 stalls at the roughness; at its residual's scale the noise explains the stall
+    fixed = fq.newton_fixed_point(fq.serial(rough), x_star + 0.05, 1e-5, tolerance=1e-12, max_halvings=8)
+    assert not fixed.converged and fixed.residual < 1e-6
+    noise = fq.evaluation_noise(fq.serial(rough), fixed.state, fixed.residual)
+    floor = fq.newton_floor(1e-12, noise)
+    assert floor == fq.NOISE_FACTOR * noise and fixed.residual <= floor
+    assert fq.orbit_verdict(0.64, 1e-5, fixed.residual, 1e-12, noise) == "stable"
+    # the smooth map gives Newton no excuse: its floor stays the tolerance
+    smooth = fq.newton_fixed_point(fq.serial(step), x_star + 0.05, 1e-5, tolerance=1e-12)
+    assert fq.newton_floor(1e-12, fq.evaluation_noise(fq.serial(step), smooth.state, 1e-9)) == 1e-12
 
 
 def test_prediction_of_a_linear_map_is_exact():

@@ -131,8 +131,12 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     fixed = fq.newton_fixed_point(evaluate, z0, settings.newton_epsilon, tolerance=settings.newton_tolerance,
                                   max_iterations=settings.newton_iterations, max_halvings=8)
     z = fixed.state
-    # The map's own noise on the scale of Newton's last residual: a residual within it is a fixed point found.
-    noise = fq.evaluation_noise(evaluate, z, max(fixed.residual, settings.newton_tolerance))
+    # The map's own noise on the scale of Newton's last residual (at most 1e-6: a larger residual is no fixed
+    # point whatever the noise): a residual within it is a fixed point found.
+    try:
+        noise = fq.evaluation_noise(evaluate, z, min(max(fixed.residual, settings.newton_tolerance), 1e-6))
+    except fq.StepFailed:
+        noise = None
     floor = fq.newton_floor(settings.newton_tolerance, noise)
     sweep = fq.epsilon_sweep(evaluate, z, settings.epsilons)
     chosen = fq.converged_epsilon(sweep, settings.plateau_tolerance)
