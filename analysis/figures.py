@@ -11,7 +11,6 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
 
 from drake_biped.analysis.series import moving_average, period  # noqa: E402
 from drake_biped.kinematics import leg_points  # noqa: E402
@@ -90,7 +89,10 @@ def _skeleton(q: np.ndarray) -> dict[str, np.ndarray]:
 
 def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: int = 15,
                    max_frames: int = 300) -> None:
-    """A planar stick-figure GIF of the walk, the camera following the hip."""
+    """A planar stick-figure GIF of the walk, the camera following the hip: drawn in the hip's frame
+    (axes fixed, so each frame redraws only the robot, the ground and the metre marks), x in the label."""
+    from PIL import Image
+
     t = trajectory["time"]
     q = trajectory["positions"]
     n_frames = int(min(max_frames, max(2, t[-1] * fps)))
@@ -98,29 +100,46 @@ def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: 
     idx = np.searchsorted(t, frame_times).clip(0, len(t) - 1)
     fig, ax = plt.subplots(figsize=(5, 3.2))
     ax.set_aspect("equal")
-    artists = {k: ax.plot([], [], "-o", color=c, lw=3, ms=3)[0]
+    ax.set_xlim(-0.8, 0.8)
+    ax.set_ylim(-0.05, 1.0)
+    ax.set_xlabel("x from the hip [m]")
+    artists = {k: ax.plot([], [], "-o", color=c, lw=3, ms=3, animated=True)[0]
                for k, c in (("torso", "0.35"), ("left", COLORS["left"]), ("right", COLORS["right"]))}
-    (ground_line,) = ax.plot([], [], color="#5a8f5a", lw=2)
-    label = ax.text(0.02, 0.93, "", transform=ax.transAxes, fontsize=8)
-    ax.set_xlabel("x [m]")
+    (ground_line,) = ax.plot([], [], color="#5a8f5a", lw=2, animated=True)
+    (marks,) = ax.plot([], [], color="#2f4f2f", lw=1, animated=True)  # a mark on the ground every metre
+    label = ax.text(0.02, 0.93, "", transform=ax.transAxes, fontsize=8, animated=True)
+    moving = (*artists.values(), ground_line, marks, label)
 
-    def draw(k):
+    def height(x: np.ndarray) -> np.ndarray:
+        return np.array([ground_height(v) for v in x]) if ground_height else np.zeros_like(x)
+
+    def draw(k: int) -> None:
         qi = q[idx[k]]
-        for name, pts in _skeleton(qi).items():
-            artists[name].set_data(pts[:, 0], pts[:, 1])
         x0 = qi[0]
-        ax.set_xlim(x0 - 0.8, x0 + 0.8)
         gx = np.linspace(x0 - 0.8, x0 + 0.8, 50)
-        gz = np.array([ground_height(v) for v in gx]) if ground_height else np.zeros_like(gx)
-        ground_line.set_data(gx, gz)
-        ax.set_ylim(gz.min() - 0.05, gz.min() + 1.0)
-        label.set_text(f"t = {t[idx[k]]:.2f} s")
-        return (*artists.values(), ground_line, label)
+        gz = height(gx)
+        z0 = gz.min()
+        for name, pts in _skeleton(qi).items():
+            artists[name].set_data(pts[:, 0] - x0, pts[:, 1] - z0)
+        ground_line.set_data(gx - x0, gz - z0)
+        mx = np.arange(np.ceil(x0 - 0.8), np.floor(x0 + 0.8) + 1.0)
+        mz = height(mx) - z0
+        marks.set_data(np.repeat(mx - x0, 3), np.column_stack([mz - 0.03, mz + 0.03, np.full_like(mz, np.nan)]).ravel())
+        label.set_text(f"t = {t[idx[k]]:.2f} s, x = {x0:.2f} m")
 
     fig.subplots_adjust(bottom=0.17, top=0.97)
-    anim = FuncAnimation(fig, draw, frames=n_frames, blit=False)
+    fig.canvas.draw()
+    background = fig.canvas.copy_from_bbox(fig.bbox)
+    frames = []
+    for k in range(n_frames):
+        draw(k)
+        fig.canvas.restore_region(background)
+        for artist in moving:
+            ax.draw_artist(artist)
+        frames.append(Image.fromarray(np.asarray(fig.canvas.buffer_rgba())).convert("RGB")
+                      .quantize(colors=64, method=Image.Quantize.FASTOCTREE))
     with atomic_file(Path(path)) as tmp:
-        anim.save(tmp, writer=PillowWriter(fps=fps))
+        frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0)
     plt.close(fig)
 
 
