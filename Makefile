@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 OUT ?= out
 
-.PHONY: setup reproduce walk test lint format window-map bench package-check clean
+.PHONY: setup reproduce walk test test-slow lint format window-map bench package-check clean
 
 setup: $(VENV)/.installed
 
@@ -15,6 +15,8 @@ $(VENV)/.installed: pyproject.toml
 	python3 -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test]'
+	# compile the controller's kernels once (numba caches them beside the sources)
+	$(PY) -c "from drake_biped.episode import warm_up; warm_up()"
 	touch $@
 
 reproduce: setup
@@ -23,8 +25,12 @@ reproduce: setup
 walk: setup
 	$(VENV)/bin/drake-biped walk --out $(OUT)/walk
 
+# The fast suite on both cores (pytest-xdist); the end-to-end simulations (marked slow) with `make test-slow`.
 test: setup
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2 -m "not slow"
+
+test-slow: setup
+	$(PY) -m pytest -q -n 2 -m slow
 
 # Build the wheel, install it into a fresh venv and run the CLI, the API and an example outside the checkout.
 package-check:

@@ -21,7 +21,7 @@ from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
 from drake_biped.model import JOINT_NAMES, joint_index
-from drake_biped.params import GRAVITY_MPS2, EpisodeConfig
+from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, SimulationParams
 from drake_biped.records import atomic_file, write_text_atomic
 from drake_biped.versions import versions
 
@@ -362,3 +362,9 @@ def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
         "position_names": np.array(["x", "z", "pitch", *JOINT_NAMES]),
         "actuator_names": np.array([f"{n}_motor" for n in JOINT_NAMES]),
     }
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's cache) every kernel of the control loop by walking a few control
+    periods, so that the first timed episode of a process spends nothing on compiling."""
+    run_episode(EpisodeConfig(sim=SimulationParams(distance_m=0.05, max_time_s=0.05)), cache=None)

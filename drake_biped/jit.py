@@ -15,3 +15,4 @@ def njit(function):
     """`function` compiled in nopython mode, cached on disk; IEEE arithmetic (no fast-math), so the compiled
     law gives the numbers the same Python code gives."""
     return numba.njit(cache=True)(function)
+

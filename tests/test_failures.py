@@ -156,6 +156,7 @@ def _learn(tmp_path, episodes=2):
             "--out", str(tmp_path / "l")]
 
 
+@pytest.mark.slow
 def test_damaged_records_are_named_and_nothing_finished_is_lost(tmp_path, capsys):
     main(_learn(tmp_path))
     capsys.readouterr()
@@ -174,6 +175,7 @@ def test_damaged_records_are_named_and_nothing_finished_is_lost(tmp_path, capsys
     assert trial.read_text() == text[: len(text) // 2]
 
 
+@pytest.mark.slow
 def test_the_run_log_counts_the_episodes_a_killed_session_never_logged(tmp_path, capsys):
     main(_learn(tmp_path))
     log = tmp_path / "l" / "run.json"

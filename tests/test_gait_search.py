@@ -125,6 +125,7 @@ def test_unknown_search_settings_are_refused():
         GaitSearchSettings(policy_draws=0)
 
 
+@pytest.mark.slow
 def test_cmaes_search_resumes_to_the_uninterrupted_result(tmp_path, client):
     start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
     kwargs = dict(offspring=4, sigma=0.3, seed=2, distance_m=0.3, windows=((0.1, 0.2),))

@@ -101,6 +101,7 @@ def _lines(path):
     return [json.loads(line) for line in path.read_text().splitlines()]
 
 
+@pytest.mark.slow
 def test_tiny_grid_finds_the_walking_point_and_a_rerun_recomputes_nothing(tmp_path, capsys):
     """Two swing amplitudes: the default gait's walks 1.2 m; one a tenth as large cannot swing the leg
     through and falls. The best point is the walker, written as a parameter file the commands accept."""

@@ -62,6 +62,7 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
     assert {"t1", "t2", "reward", "cost_of_transport", "distance_m", "fell"} <= set(first[0])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("learner", ["cmaes", "pgpe"])
 def test_every_learner_resumes_to_the_uninterrupted_result(tmp_path, learner):
     """Cut inside a CMA-ES generation (6 samples) and inside a PGPE pair: the same records as GARB's, and
@@ -153,6 +154,7 @@ def test_run_log_keeps_every_session_and_their_totals(tmp_path):
     assert run["learning_wall_s"] == pytest.approx(sum(s["learning_wall_s"] for s in run["sessions"]))
 
 
+@pytest.mark.slow
 def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client):
     from drake_biped.experiments import compare_learners, window_map
 

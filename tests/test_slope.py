@@ -95,6 +95,7 @@ def test_slope_refuses_bad_options(tmp_path, capsys, argv, match):
     assert match in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_slope_story_on_a_short_setting(tmp_path):
     """2 m level, then 2 m up 0.02 rad. The default gait does not climb. The climbing gait found by the
     grid search climbs without a torque-free period and falls with the 0.2-0.4 s period that saves energy

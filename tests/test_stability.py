@@ -121,6 +121,7 @@ def test_bad_settings_are_refused():
         StabilitySettings(spread=0.7)
 
 
+@pytest.mark.slow
 def test_a_rerun_recomputes_nothing(tmp_path):
     from drake_biped.experiments.executor import dask_client
 
