@@ -9,6 +9,7 @@ by Python-Markdown (tables extension), figures linked from the experiments' fold
 from __future__ import annotations
 
 import html
+import json
 import re
 from pathlib import Path
 from typing import Any
@@ -119,7 +120,22 @@ def table_vii_rows(summary: dict[str, Any]) -> tuple[list[str], str, str]:
     return rows, ", ".join(changes), f"{DIFFERS}: {same} of 3 CPG parameters move as in Table VII{note}"
 
 
-def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any]) -> str:
+# The claims' rows of the full report, in order: the keys a quick run matches its own rows with.
+CLAIM_KEYS = ("table_iii", "paper_gait", "grid", "learn", "learn_variant", "compare_learners", "stability",
+              "push_margin", "floquet", "learner_learn", "learner_stability", "slope_default", "slope", "slope2deg",
+              "table_vii", "time_step")
+# The learning runs whose evaluated windows a quick run re-walks (DIR/<source>/learning.json).
+CHECKED_SOURCES = {"learn": ("learn",), "learn_variant": ("learn_variant",), "learner_learn": ("learner_gait/learn",)}
+
+
+def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]]:
+    """The verdict tuples as keyed rows (CLAIM_KEYS)."""
+    if len(verdicts) != len(CLAIM_KEYS):
+        raise ValueError(f"expected {len(CLAIM_KEYS)} claims, got {len(verdicts)}")
+    return [{"key": k, "what": a, "paper": b, "ours": c, "verdict": d} for k, (a, b, c, d) in zip(CLAIM_KEYS, verdicts)]
+
+
+def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any]) -> tuple[str, list]:
     LEVEL_WINDOW = tuple(s["push_margin"]["settings"]["window"])  # the window compared with none
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
     verdicts: list[tuple[str, str, str, str]] = []  # (what, paper, ours, verdict)
@@ -349,7 +365,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "`--quick`) is the full run.",
         "",
     ]
-    return "\n".join(lines)
+    return "\n".join(lines), verdicts
 
 
 VERDICT_COLOURS = ((REPRODUCED, "#c8e6c9"), (PARTLY, "#ffe0b2"), (DIFFERS, "#ffe0b2"), (NOT_REPRODUCED, "#ffcdd2"),
@@ -491,10 +507,179 @@ def report_html(markdown_text: str) -> str:
             "font-size:90%}img{max-width:100%}</style></head><body>" + body + "</body></html>\n")
 
 
+def full_run_digest(out: Path, verdicts: list[tuple[str, str, str, str]], profile: Any,
+                    code: dict[str, Any]) -> dict[str, Any]:
+    """What a quick run needs of a full one: its keyed verdict rows, and for the learning runs of
+    CHECKED_SOURCES their configuration, the code that made them and the C_mt each evaluated window (and no
+    window) gave, to be re-walked and compared. `code`: the report's own."""
+    checks = {}
+    for key, (source,) in CHECKED_SOURCES.items():
+        record = json.loads((out / source / "learning.json").read_text())
+        ev = record["evaluation"]
+        checks[key] = {"source": f"{source}/learning.json", "config": record["settings"]["config"],
+                       "versions": record["versions"],
+                       "no_window": ev["no_window"]["cost_of_transport"],
+                       "learned": [{k: r[k] for k in ("trial", "t1", "t2", "cost_of_transport", "fell")}
+                                   for r in ev["learned"]]}
+    return {"profile": profile.name, "report_code": code,
+            "code": checks[next(iter(CHECKED_SOURCES))]["versions"], "rows": claim_rows(verdicts), "checks": checks}
+
+
 def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Any,
-                 code: dict[str, Any]) -> list[Path]:
-    text = report_markdown(out, summaries, profile, code)
+                 code: dict[str, Any], full_run: dict[str, Any] | None = None) -> list[Path]:
+    """report.md, report.html and report_summary.png; a full run also writes verdicts.json (full_run_digest),
+    which a quick run checks; a quick run's report is quick_report_markdown's, beside `full_run`."""
     paths = [out / "report.md", out / "report.html"]
+    if profile.name == "quick":
+        text = quick_report_markdown(out, summaries, profile, code, full_run)
+    else:
+        text, verdicts = report_markdown(out, summaries, profile, code)
+        paths.append(out / "verdicts.json")
+        write_text_atomic(paths[-1], json.dumps(full_run_digest(out, verdicts, profile, code), indent=1) + "\n")
     write_text_atomic(paths[0], text)
     write_text_atomic(paths[1], report_html(text))
     return paths
+
+
+CANNOT_JUDGE = "cannot judge at this size"
+
+
+def _check_text(check: dict[str, Any] | None) -> str:
+    if not check:
+        return ""
+    n, agree = check["walks"], check["agree"]
+    if agree == n:
+        return (f" ✓ checked here: {n} re-walk{'s give' if n > 1 else ' gives'} the recorded C_mt to the last "
+                "digit")
+    return (f" ✗ checked here: {agree} of {n} re-walks give the recorded C_mt to the last digit "
+            f"(largest difference {_pct(check['max_relative_difference'])})")
+
+
+def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) -> list[dict[str, str]]:
+    """One row per claim of the full report: what this quick run measured (or that it did not run it, or
+    that its size cannot judge it) beside the shipped full run's verdict, with the live check of the
+    full run's learned windows where it has one."""
+    mine: dict[str, tuple[str, str]] = {}
+    if "table_iii" in s:
+        t3 = s["table_iii"]
+        mine["table_iii"] = (("walks" if not t3["fell"] else f"falls after {t3['steps']} steps")
+                             + f", {t3['distance_m']:.2f} m", REPRODUCED if not t3["fell"] else NOT_REPRODUCED)
+    if "paper_gait" in s:
+        pg = s["paper_gait"]
+        mine["paper_gait"] = (("walks" if not pg["fell"] else f"falls after {pg['steps']} steps")
+                              + f", {pg['distance_m']:.2f} m", REPRODUCED if not pg["fell"] else NOT_REPRODUCED)
+    if "learn" in s:
+        ours, _ = reduction_verdict(s["learn"]["evaluation"])
+        st = s["learn"]["settings"]
+        mine["learn"] = (f"{ours} after {st['trials']} × {st['episodes']} episodes (the paper: 500)", CANNOT_JUDGE)
+    if "floquet" in s:
+        fl = s["floquet"]["gaits"]
+        mine["floquet"] = (", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
+                                     for name, g in fl.items()), BEYOND)
+    checks = (s.get("full_run") or {}).get("checks", {})
+    rows = []
+    for row in (full_run or {}).get("rows", []):
+        ours, verdict = mine.get(row["key"], ("not run at this size", ""))
+        rows.append({"what": row["what"], "paper": row["paper"], "this_run": ours, "this_verdict": verdict,
+                     "full_run": f"{row['ours']}: {row['verdict']}" + _check_text(checks.get(row["key"])),
+                     "full_verdict": row["verdict"]})
+    return rows
+
+
+def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any],
+                          full_run: dict[str, Any] | None) -> str:
+    rows = quick_rows(s, full_run)
+    wall = sum(x.get("wall_s") or 0.0 for x in s.values())
+    quick_summary_figure(rows, out / "report_summary.png")
+    walk, fr = s["walk"], s.get("full_run") or {}
+    full_code = (full_run or {}).get("code", {})
+    lines = [
+        "# drake-biped: the paper reproduced — quick run, beside the shipped full run",
+        "",
+        f"Profile **quick** ({_profile_text(profile)}); {len(s)} steps, {wall / 60:.1f} min. drake-biped "
+        f"{code.get('drake_biped')} ({code.get('git_commit')}), Drake {code.get('drake')}. This run is too small "
+        "to judge most of the paper's claims (learning needs hundreds of episodes, a stability cell several "
+        "trials): where it cannot, its column says so, and the full run's verdict stands beside it, "
+        f"from the records shipped with the package (full run: drake-biped {full_code.get('git_commit')}, "
+        f"Drake {full_code.get('drake')}). The full run's learned windows, and no window, were walked again "
+        "here: where they give the C_mt the full run recorded, its row says so (✓).",
+        "",
+        "| what | paper | this run (quick) | full run (checked here) |",
+        "|---|---|---|---|",
+    ]
+    lines += [f"| {r['what']} | {r['paper']} | {r['this_run']}" + (f" — **{r['this_verdict']}**" if r["this_verdict"]
+              else "") + f" | {r['full_run'].replace(r['full_verdict'], '**' + r['full_verdict'] + '**', 1)} |"
+              for r in rows]
+    lines += [
+        "",
+        "![verdicts](report_summary.png)",
+        "",
+        "## The walk (`walk/`)",
+        "",
+        f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
+        f"{_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
+        f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
+        "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
+        "",
+        "![walk](walk/walk.png)",
+        "",
+        "## The full run's learned windows, walked again here (`full_run/`)",
+        "",
+        "| learning run | window (s) | C_mt recorded | C_mt here | same |",
+        "|---|---|---|---|---|",
+    ]
+    for check in fr.get("checks", {}).values():
+        for w in check["rows"]:
+            window = "none" if w["t2"] <= max(0.0, w["t1"]) else f"{max(0.0, w['t1']):.3f}–{w['t2']:.3f}"
+            lines.append(f"| {check['source']} | {window} | {_num(w['recorded'], 6)} | {_num(w['measured'], 6)} | "
+                         + ("yes" if w["recorded"] == w["measured"] else _pct(w["relative_difference"])) + " |")
+    if "learn" in s:
+        lines += ["", "## Learning, a few episodes (`learn/`)", "",
+                  f"GARB with the paper's settings for {s['learn']['settings']['trials']} × "
+                  f"{s['learn']['settings']['episodes']} episodes: the machinery of Experiment 1, too short to "
+                  "judge it.", "", embed(_read(out, "learn/table_v.md"), "learn"),
+                  "![Fig. 4](learn/fig4_reward.png)", ""]
+    if "floquet" in s:
+        for name in s["floquet"]["gaits"]:
+            lines += [embed(_read(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
+                      f"![Floquet multipliers, {name}](floquet/{name}/floquet.png)", ""]
+    lines += ["The full report with every experiment: `benchmarks/results/reproduce-full/report.md` in the "
+              "repository; `drake-biped reproduce --out DIR` (without `--quick`) runs it.", ""]
+    return "\n".join(lines)
+
+
+def quick_summary_figure(rows: list[dict[str, str]], path: Path) -> None:
+    """The quick report's table as a picture: this run's column beside the full run's, each verdict coloured."""
+    import textwrap
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    widths = (30, 20, 40, 50)
+    table_rows = [(r["what"], r["paper"], r["this_run"] + (f" — {r['this_verdict']}" if r["this_verdict"] else ""),
+                   r["full_run"]) for r in rows]
+    cells = [["\n".join(textwrap.wrap(text.replace("**", ""), w)) or "—" for text, w in zip(row, widths)]
+             for row in table_rows]
+    heights = [max(c.count("\n") + 1 for c in row) for row in cells]
+    fig, ax = plt.subplots(figsize=(14, 0.9 + 0.2 * (sum(heights) + len(heights))))
+    ax.axis("off")
+    table = ax.table(cellText=cells, colLabels=["claim", "paper", "this run (quick)", "full run (checked here)"],
+                     loc="upper center", cellLoc="left", colWidths=[w / sum(widths) for w in widths])
+    table.auto_set_font_size(False)
+    table.set_fontsize(8)
+    total = sum(heights) + len(heights) + 1
+    for (r, c), cell in table.get_celld().items():
+        cell.set_height((1 if r == 0 else heights[r - 1] + 1) / total * 0.95)
+        if r == 0:
+            cell.set_facecolor("#eeeeee")
+            continue
+        verdict = {2: rows[r - 1]["this_verdict"], 3: rows[r - 1]["full_verdict"]}.get(c)
+        for key, colour in VERDICT_COLOURS:
+            if verdict and verdict.startswith(key):
+                cell.set_facecolor(colour)
+                break
+    ax.set_title("drake-biped reproduce (quick): this run beside the shipped full run", fontsize=10)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
+    plt.close(fig)

@@ -396,7 +396,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     check_cluster_options(args.workers, args.scheduler, args.force)  # before the folder is claimed for this profile
     reproduce.check_out(out, profile)
     hours = profile.expected_minutes / 60
-    print(f"reproduce ({profile.name}): {len(reproduce.Reproduction.STEPS)} experiments into {out}/, expected "
+    print(f"reproduce ({profile.name}): {len(reproduce.steps_of(profile))} experiments into {out}/, expected "
           "about " + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
           + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
     with _client(args) as client:

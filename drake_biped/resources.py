@@ -14,7 +14,7 @@ from pathlib import Path
 
 from drake_biped.params import EpisodeConfig, ParameterError
 
-__all__ = ["gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml"]
+__all__ = ["full_run_digest", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml"]
 
 
 def _package_path(package: str, *parts: str) -> Path:
@@ -26,6 +26,14 @@ def _package_path(package: str, *parts: str) -> Path:
 def model_package_xml() -> Path:
     """The `package.xml` of the `drake_biped` model package (biped.urdf beside it)."""
     return _package_path("drake_biped.models", "package.xml")
+
+
+def full_run_digest() -> dict:
+    """The shipped full reproduction's verdicts and learned windows (its verdicts.json, shipped as
+    drake_biped/results/full_run.json): what a quick run shows and checks beside its own numbers."""
+    import json
+
+    return json.loads(_package_path("drake_biped", "results", "full_run.json").read_text())
 
 
 def gait_names() -> list[str]:

@@ -14,7 +14,7 @@ from drake_biped.analysis.reproduce_report import (
     stability_verdict,
     table_vii_rows,
 )
-from drake_biped.experiments.reproduce import QUICK, Profile, Reproduction, check_out
+from drake_biped.experiments.reproduce import QUICK, Profile, Reproduction, check_out, steps_of
 from drake_biped.params import ParameterError
 
 
@@ -103,7 +103,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     logs = []
     with dask_client(workers=2) as client:
         summaries = Reproduction(tmp_path, SMOKE, client, workers=2, log=logs.append).run_all()
-    assert list(summaries) == list(Reproduction.STEPS)
+    assert list(summaries) == list(steps_of(SMOKE)) and "full_run" not in summaries
     text = (tmp_path / "report.md").read_text()
     for heading in SECTIONS:
         assert heading in text, heading
@@ -141,5 +141,74 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
 
     logs.clear()
     again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append).run_all()
-    assert logs == [f"[{Reproduction.folder(step)}] finished earlier: reused" for step in Reproduction.STEPS]
+    assert logs == [f"[{Reproduction.folder(step)}] finished earlier: reused" for step in steps_of(SMOKE)]
     assert again == summaries and (tmp_path / "report.md").read_text() == text
+    # a full run leaves what a quick run checks: its verdict rows, keyed, and its learned windows' C_mt
+    import json
+
+    digest = json.loads((tmp_path / "verdicts.json").read_text())
+    assert [r["verdict"] for r in digest["rows"]] == [row.split(" | ")[3].strip(" |*") for row in table]
+    assert digest["checks"]["learner_learn"]["no_window"] == summaries["learner_learn"]["evaluation"]["no_window"][
+        "cost_of_transport"]
+
+
+def _digest():
+    rows = [{"key": k, "what": k, "paper": "p", "ours": f"{k} measured", "verdict": v} for k, v in
+            (("table_iii", NOT_REPRODUCED), ("learn", NOT_REPRODUCED), ("learner_learn", REPRODUCED),
+             ("stability", REPRODUCED))]
+    return {"rows": rows, "code": {}, "checks": {}}
+
+
+def test_a_quick_row_never_judges_what_its_size_cannot_and_shows_the_full_runs_verdict_checked():
+    from drake_biped.analysis.reproduce_report import CANNOT_JUDGE, quick_rows
+
+    s = {"table_iii": {"fell": True, "steps": 2, "distance_m": 1.22},
+         "learn": {"settings": {"trials": 2, "episodes": 4}, "evaluation": _evaluation(-0.011)},
+         "full_run": {"checks": {"learner_learn": {"walks": 6, "agree": 6, "max_relative_difference": 0.0},
+                                 "learn": {"walks": 2, "agree": 1, "max_relative_difference": 0.02}}}}
+    rows = {r["what"]: r for r in quick_rows(s, _digest())}
+    # measured here and judgeable at any size: its own verdict
+    assert rows["table_iii"]["this_verdict"] == NOT_REPRODUCED and "1.22 m" in rows["table_iii"]["this_run"]
+    # a few episodes of learning: what it measured, no verdict of its own, the full run's beside it
+    assert rows["learn"]["this_verdict"] == CANNOT_JUDGE and "after 2 × 4 episodes" in rows["learn"]["this_run"]
+    assert rows["learn"]["full_run"].startswith("learn measured: not reproduced")
+    assert "✗ checked here: 1 of 2 re-walks" in rows["learn"]["full_run"]
+    assert rows["learner_learn"]["this_run"] == "not run at this size" and rows["learner_learn"]["this_verdict"] == ""
+    assert rows["learner_learn"]["full_run"].endswith("✓ checked here: 6 re-walks give the recorded C_mt to the "
+                                                      "last digit")
+    assert "checked" not in rows["stability"]["full_run"]  # nothing of Table VI is re-walked
+    assert not any(r["this_verdict"] == NOT_REPRODUCED for k, r in rows.items() if k != "table_iii")
+
+
+def test_the_packaged_full_run_is_the_shipped_full_runs_verdicts():
+    """The package carries the committed full run's verdicts.json (a wheel has no benchmarks/ folder): the two
+    copies must be the same file."""
+    from pathlib import Path
+
+    from drake_biped.resources import full_run_digest
+
+    shipped = Path(__file__).resolve().parents[1] / "benchmarks" / "results" / "reproduce-full" / "verdicts.json"
+    if not shipped.is_file():
+        pytest.skip("not a checkout")
+    import json
+
+    assert full_run_digest() == json.loads(shipped.read_text())
+    assert {r["key"] for r in full_run_digest()["rows"]} >= {"learn", "learner_learn", "stability", "floquet"}
+
+
+@pytest.mark.slow
+def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_numbers(tmp_path):
+    """The quick profile's check of the shipped full run: every learned window (and no window) re-walked
+    gives the C_mt the full run recorded, to the last digit; its report carries both columns."""
+    quick = Profile(**{**QUICK.to_dict(), "steps": ("walk", "table_iii", "full_run"), "distance_m": 2.0})
+    from drake_biped.experiments.executor import dask_client
+
+    with dask_client(workers=2) as client:
+        summaries = Reproduction(tmp_path, quick, client, workers=2, log=lambda _: None).run_all()
+    checks = summaries["full_run"]["checks"]
+    assert set(checks) == {"learn", "learn_variant", "learner_learn"}
+    for check in checks.values():
+        assert check["agree"] == check["walks"], check["rows"]
+    text = (tmp_path / "report.md").read_text()
+    assert "| this run (quick) | full run (checked here) |" in text
+    assert "✓ checked here: 6 re-walks" in text and "not run at this size" in text

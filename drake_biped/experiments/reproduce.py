@@ -46,7 +46,7 @@ from drake_biped.records import read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-__all__ = ["FULL", "LEARNER_GAIT", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run"]
+__all__ = ["FULL", "LEARNER_GAIT", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run", "steps_of"]
 
 LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none under pushes (as `stability` defaults)
 SLOPE_START = {"slope": (0.1, 0.6), "slope2deg": (0.1, 0.7)}  # each climbing gait's best level window
@@ -81,13 +81,19 @@ class Profile:
     compare: tuple[int, int] = (1, 6)  # trials, episodes per learner in the side-by-side comparison
     floquet_epsilons: tuple[float, ...] = ()  # the Floquet sweep's perturbations (empty: its default)
     floquet_newton_iterations: int = 6  # Newton's iterations towards each orbit (FloquetSettings' default)
+    floquet_gaits: tuple[str, ...] = ("none", "window", "learned")  # whose orbits: no window, LEVEL_WINDOW, learned
+    steps: tuple[str, ...] = ()  # the steps run, in Reproduction.STEPS' order (empty: all of them)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
 
 
-QUICK = Profile("quick", 10.0, 2, 1, (2, 6), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
-                7.0)
+# The quick run: the walk, the cheap verdicts (Table III and the paper gait fall in two steps), the shipped
+# full run's learned windows walked again, a few learning episodes and one Floquet orbit. What it is too small
+# to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
+QUICK = Profile("quick", 10.0, 2, 1, (2, 3), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
+                2.0, floquet_epsilons=(1e-7, 1e-6, 1e-5), floquet_newton_iterations=5, floquet_gaits=("none",),
+                steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
                (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 455.0, compare=(5, 300))
 
@@ -165,6 +171,60 @@ class Reproduction:
                     "initial": config.initial.to_dict()}
 
         return self.experiment("paper_gait", {"config": config.to_dict()}, run)
+
+    def table_iii(self) -> dict:
+        """Table III's CPG with the default gait's other gains, from the paper's initiation (the grid runs it
+        too; the quick run runs it alone)."""
+        from drake_biped.experiments.executor import run_kept
+
+        config = self.level.replace(cpg=PAPER_CPG, initial=InitialConditions())
+
+        def run(folder: Path) -> dict:
+            with self.client() as client:
+                r = run_kept(client, {"t": (folder / "table_iii.json", config.to_dict())})["t"]
+            return {"distance_m": r["distance_m"], "fell": r["fell"], "steps": len(r["steps"])}
+
+        return self.experiment("table_iii", {"config": config.to_dict()}, run)
+
+    def full_run(self) -> dict:
+        """The shipped full run's learned windows (and no window) walked again, each against the C_mt the
+        full run recorded (resources.full_run_digest)."""
+        from drake_biped.experiments.executor import run_kept
+        from drake_biped.experiments.learning import window_of
+        from drake_biped.resources import full_run_digest
+
+        digest = full_run_digest()
+
+        def run(folder: Path) -> dict:
+            jobs, wanted = {}, {}
+            for key, check in digest["checks"].items():
+                base = EpisodeConfig.from_dict(check["config"])
+                rows = [(0.0, 0.0, check["no_window"])] + [(r["t1"], r["t2"], r["cost_of_transport"])
+                                                           for r in check["learned"]]
+                for t1, t2, recorded in rows:  # trials that ended on the same window are one walk
+                    window = window_of((t1, t2))
+                    name = f"{key}_{window.start_s:.6f}_{window.end_s:.6f}" if window.end_s > window.start_s \
+                        else f"{key}_none"
+                    if name not in jobs:
+                        jobs[name] = (folder / f"{name}.json", base.replace(window=window).to_dict())
+                        wanted.setdefault(key, []).append((name, t1, t2, recorded))
+            with self.client() as client:
+                results = run_kept(client, jobs)
+            checks = {}
+            for key, rows in wanted.items():
+                out = []
+                for name, t1, t2, recorded in rows:
+                    measured = results[name]["cost_of_transport"]
+                    diff = (None if recorded is None or measured is None else measured / recorded - 1.0)
+                    out.append({"t1": t1, "t2": t2, "recorded": recorded, "measured": measured,
+                                "relative_difference": diff})
+                diffs = [abs(r["relative_difference"]) for r in out if r["relative_difference"] is not None]
+                checks[key] = {"source": digest["checks"][key]["source"], "walks": len(out),
+                               "agree": sum(r["recorded"] == r["measured"] for r in out),
+                               "max_relative_difference": max(diffs, default=None), "rows": out}
+            return {"checks": checks, "full_run_code": digest["code"]}
+
+        return self.experiment("full_run", {"checks": digest["checks"]}, run)
 
     def compare_learners(self) -> dict:
         from drake_biped.experiments import compare_learners
@@ -282,13 +342,15 @@ class Reproduction:
         from drake_biped.experiments.learning import best_learned_trial
 
         windows = {"none": (0.0, 0.0), "window": LEVEL_WINDOW}
-        for source in ("learn", "learn_variant"):  # the learned window: the paper's settings' if they learned one
+        for source in ("learn", "learn_variant") if "learned" in self.profile.floquet_gaits else ():
+            # the learned window: the paper's settings' if they learned one
             try:
                 row = best_learned_trial(json.loads((self.out / source / "learning.json").read_text()), source)
             except (OSError, ValueError):
                 continue
             windows["learned"] = (max(0.0, float(row["t1"])), max(0.0, float(row["t2"])))
             break
+        windows = {k: v for k, v in windows.items() if k in self.profile.floquet_gaits}
 
         def run(folder: Path) -> dict:
             out = {}
@@ -301,6 +363,7 @@ class Reproduction:
                 out[name] = {"window": [t1, t2], **{k: record[k] for k in (
                     "spectral_radius", "converged_epsilon", "fixed_point_residual", "multipliers", "plateau",
                     "sampling_phase_drift")}, "newton_tolerance": record["settings"]["newton_tolerance"],
+                    "evaluation_noise": record.get("evaluation_noise"),
                     "decay": {k: record["decay"][k] for k in ("predicted", "map_iterated", "continued")},
                     "wall_time_s": record["wall_time_s"]}
             return {"gaits": out}
@@ -450,7 +513,7 @@ class Reproduction:
 
     # The learner's gait, which carries the paper's learning result, runs early, so that an interrupted run
     # has it first.
-    STEPS = ("walk", "time_step", "grid", "paper_gait", "learner_window_map", "learner_learn", "learner_stability",
+    STEPS = ("walk", "time_step", "grid", "table_iii", "paper_gait", "full_run", "learner_window_map", "learner_learn", "learner_stability",
              "window_map", "learn", "learn_variant", "compare_learners", "stability", "push_margin", "floquet",
              "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
 
@@ -458,12 +521,24 @@ class Reproduction:
         self.out.mkdir(parents=True, exist_ok=True)
         code = versions()
         summaries = {}
-        for step in self.STEPS:
+        for step in steps_of(self.profile):
             summaries[step] = getattr(self, step)()
         from drake_biped.analysis.reproduce_report import write_report
 
-        write_report(self.out, summaries, self.profile, code)
+        full_run = None
+        if self.profile.name == "quick":
+            from drake_biped.resources import full_run_digest
+
+            full_run = full_run_digest()
+        write_report(self.out, summaries, self.profile, code, full_run)
         return summaries
+
+
+def steps_of(profile: Profile) -> tuple[str, ...]:
+    """The steps a profile runs, in order: its own list, or every step but the quick run's own two (the grid
+    runs Table III; a full run has no full run to check)."""
+    chosen = profile.steps or tuple(s for s in Reproduction.STEPS if s not in ("table_iii", "full_run"))
+    return tuple(s for s in Reproduction.STEPS if s in chosen)
 
 
 def _map_summary(record: dict) -> dict:
