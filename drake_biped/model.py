@@ -143,7 +143,9 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
     # the foot of the slope), so every accepted level length (up to 1000 m) has a slope to draw after it.
     visual_end = 60.0 + (ground.level_length_m or 0.0)
     add_marks(-2.0, visual_end)
-    if ground.level_length_m is None:
+    if ground.level_length_m is None or ground.slope_rad == 0.0:
+        # One surface is one half-space: a level length before no slope is the level ground itself (two
+        # coincident half-spaces would give each foot sphere two contacts, twice the ground's stiffness).
         add_plane("ground", ground.slope_rad, 0.0)
         add_visual("ground_visual", ground.slope_rad, -5.0, visual_end, -5.0 * math.tan(ground.slope_rad))
     else:

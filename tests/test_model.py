@@ -173,3 +173,31 @@ def test_a_model_the_kinematics_does_not_match_is_refused_by_name(tmp_path, old,
     package = _model_copy(tmp_path, lambda t: t.replace(old, new, 1))
     with pytest.raises(ModelError, match=match):
         add_biped(DiagramBuilder(), Ground(), 1e-3, package_xml=package)
+
+
+def _collision_grounds(ground):
+    from pydrake.systems.framework import DiagramBuilder
+
+    handles = add_biped(DiagramBuilder(), ground, 1e-3)
+    plant = handles.plant
+    return [handles.scene_graph.model_inspector().GetName(g)
+            for g in plant.GetCollisionGeometriesForBody(plant.world_body())]
+
+
+def test_a_ground_is_one_surface_wherever_it_is_one_surface():
+    """A level length before no slope is the level ground: one half-space, not two coincident ones (each foot
+    sphere met the ground twice: twice its stiffness, C_mt 0.2209 instead of 0.2246 on 1 m)."""
+    assert len(_collision_grounds(Ground())) == 1
+    assert len(_collision_grounds(Ground(level_length_m=5.0))) == 1
+    assert len(_collision_grounds(Ground(slope_rad=0.02, level_length_m=5.0))) == 2  # a level part, then a slope
+
+
+def test_a_walk_with_a_level_length_on_level_ground_is_the_walk_without_it():
+    from drake_biped.episode import run_episode
+    from drake_biped.params import EpisodeConfig, SimulationParams
+
+    sim = SimulationParams(distance_m=1.0, max_time_s=5.0)
+    plain = run_episode(EpisodeConfig(sim=sim))
+    with_level = run_episode(EpisodeConfig(sim=sim, ground=Ground(level_length_m=5.0)))
+    assert with_level.cost_of_transport == plain.cost_of_transport
+    assert with_level.distance_m == plain.distance_m
