@@ -102,6 +102,10 @@ def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False
     p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default: 0)")
 
 
+# The longest time step (and control period) at which the default gait's walk has been measured to converge.
+CONVERGED_TIME_STEP_S = 0.002
+
+
 def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     from drake_biped.resources import load_gait
 
@@ -119,6 +123,10 @@ def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     if args.level_length is not None:
         changes["ground.level_length_m"] = args.level_length
     config = config.override(changes)
+    if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
+        print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
+              "steps at which the default gait's walk converges (docs/RESULTS.md, 'Time step'); from 5 ms its "
+              "control loop diverges, which ends an episode as 'diverged'", file=sys.stderr)
     return config if args.seed is None else config.replace(seed=args.seed)
 
 

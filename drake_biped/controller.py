@@ -88,6 +88,8 @@ CONTROLLER_STATE = VectorLayout("controller_state", (
                                              "first; NaN until read in this step (rad/s)"),
     Field("swing_travel_rad", 1, "integral of zeta since T_n: the swing thigh's travel under the integrated "
                                  "reading (rad)"),
+    Field("torque_reversals", 1, "times a joint's torque jumped by more than REVERSAL_FACTOR times its motor's "
+                                 "limit from one control period to the next (a diverging control loop)"),
 ))
 N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
@@ -98,6 +100,7 @@ COM_X, TARGET_X, DONE, STATE_TIME = _o("com_x_m"), _o("target_x_m"), _o("done"),
 Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
 POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_work_j"), _o("previous_clearance_m")
 PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_rates_radps"), _o("swing_travel_rad")
+REVERSALS = _o("torque_reversals")
 del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
@@ -124,7 +127,16 @@ FALL_REASONS = {
     2: "torso tilted beyond the fall angle",
     3: "knee touched the ground",
     4: "non-finite state",
+    5: "the control loop diverged",
 }
+# A diverging control loop (a control period too long for the servos' gains: the torques chatter between their
+# limits) is told from a walk by torque reversals: a joint's torque jumping by more than REVERSAL_FACTOR times
+# its motor's limit from one period to the next. A walk has none (the default gait at 1 and 2 ms, coasting_wide,
+# climbing, paper: 0); the default gait at 5, 10 and 20 ms has 88-1208 before it falls. DIVERGED_REVERSALS of them
+# end the episode as diverged.
+REVERSAL_FACTOR = 1.5
+DIVERGED_REVERSALS = 5
+DIVERGED_CODE = 5
 
 
 def touchdown_capacity(config: EpisodeConfig) -> int:
@@ -451,7 +463,12 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     if com_x >= s[TARGET_X]:
         s[DONE] = 1.0
     for i in range(6):
+        limit = law[L_HIP_LIMIT] if i % 3 == 0 else (law[L_KNEE_LIMIT] if i % 3 == 1 else law[L_ANKLE_LIMIT])
+        if abs(s[TAU + i] - tau[i]) > REVERSAL_FACTOR * limit:
+            s[REVERSALS] += 1.0
         tau[i] = s[TAU + i]
+    if s[FALL] == 0.0 and s[REVERSALS] >= DIVERGED_REVERSALS:
+        s[FALL] = 5.0
     if s[FALL] != 0.0:
         code |= FELL
     if s[DONE] != 0.0:

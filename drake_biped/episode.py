@@ -211,8 +211,8 @@ def simulate(
     cache=None always builds a new one); its context is reset to the defaults and this episode's numbers
     and initial state. The controller ends the episode itself (a fall, or the distance walked); the
     Simulator runs no Python between control updates unless `progress` asks for reports (every 0.25
-    simulated s). Reasons: "distance", "fall", "time limit", or "simulation failed: ..." (a diverging
-    contact solve).
+    simulated s). Reasons: "distance", "fall", "time limit", "diverged" (the control loop: see
+    controller.REVERSAL_FACTOR), or "simulation failed: ..." (a diverging contact solve).
     """
     if meshcat is None and cache is not None:
         parts, simulator = cache.get(config, record, log_period_s)
@@ -249,7 +249,10 @@ def simulate(
                 parts.plant.SetVelocities(plant_ctx, v)
         simulator.AdvanceTo(config.sim.max_time_s)
         s = parts.controller.state(ctrl_ctx)
-        reason = "fall" if s.fall_code != 0.0 else ("distance" if s.done else "time limit")
+        if s.fall_code == ctl.DIVERGED_CODE:
+            reason = "diverged"
+        else:
+            reason = "fall" if s.fall_code != 0.0 else ("distance" if s.done else "time limit")
     except RuntimeError as exc:  # a diverging contact solve: the episode is a fall, not a crash
         reason = f"simulation failed: {exc}".splitlines()[0]
     wall = time.perf_counter() - wall0
@@ -279,7 +282,12 @@ def run_episode(
     t_end = s.state_time_s
     fall_code = int(s.fall_code)
     fell = reason != "distance" and reason != "time limit"
-    fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
+    if reason == "diverged":
+        fall_reason = (f"the control loop diverged: {int(s.torque_reversals)} torque reversals of more than "
+                       f"{ctl.REVERSAL_FACTOR:g} x a motor's limit between control periods (the control period "
+                       f"{config.sim.control_period_s:g} s is too long for the servos)")
+    else:
+        fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
 
     q0, _, _, _ = initial_state(config)
     distance = s.com_x_m - center_of_mass(q0, parts.masses)[0]

@@ -7,7 +7,7 @@ import pytest
 
 from drake_biped.analysis.cost_of_transport import positive_work
 from drake_biped.diagram import TorsoPush, build_diagram
-from drake_biped.episode import EpisodeResult, run_episode
+from drake_biped.episode import EpisodeResult, run_episode, simulate
 from drake_biped.model import build_plant
 from drake_biped.params import (
     GRAVITY_MPS2,
@@ -236,7 +236,6 @@ def test_a_kick_changes_the_swing_hip_and_nothing_else_changes_without_one():
 
 def test_the_first_swing_starts_from_the_initial_cpg_phase():
     """InitialConditions.cpg_phase_rad seeds gamma: the first update advances it from there (eq. 2)."""
-    from drake_biped.episode import simulate
 
     config = EpisodeConfig(initial=InitialConditions(cpg_phase_rad=1.2),
                            sim=SimulationParams(distance_m=0.05, max_time_s=0.0105))
@@ -246,3 +245,19 @@ def test_the_first_swing_starts_from_the_initial_cpg_phase():
     zero = simulate(config.replace(initial=InitialConditions()), cache=None)
     s0 = zero[0].controller.state(zero[0].controller.GetMyContextFromRoot(zero[1].get_context()))
     assert s.cpg_phase - s0.cpg_phase == pytest.approx(1.2, abs=0.01)
+
+
+def test_a_diverging_control_loop_is_named_diverged_not_a_fall():
+    """At a 10 ms control period the servos chatter between their limits (the work 2273 J in 0.94 s, C_mt
+    803, was reported as an ordinary fall): the episode now ends as 'diverged' at the fifth torque reversal,
+    while the walk at 1 ms has none."""
+    from drake_biped import controller as ctl
+
+    coarse = run_episode(EpisodeConfig().override({"sim.time_step_s": 0.01, "sim.control_period_s": 0.01,
+                                                   "sim.distance_m": 1.0}))
+    assert coarse.termination == "diverged" and coarse.fell
+    assert coarse.fall_reason.startswith("the control loop diverged: 5 torque reversals")
+    assert coarse.duration_s < 0.2  # caught within a few periods, not after a second of chattering
+    parts, simulator, reason, _ = simulate(EpisodeConfig(sim=SimulationParams(distance_m=2.0, max_time_s=8.0)))
+    state = parts.controller.state(parts.controller.GetMyContextFromRoot(simulator.get_context()))
+    assert reason == "distance" and state.torque_reversals == 0.0 and ctl.DIVERGED_REVERSALS == 5

@@ -596,3 +596,18 @@ def test_a_walk_on_a_level_part_longer_than_60_m_runs(tmp_path, capsys):
     record = json.loads((out / "result.json").read_text())
     assert record["config"]["ground"] == {"slope_rad": 0.02, "level_length_m": 100.0, "friction": 1.0}
     assert record["termination"] == "distance" and record["distance_m"] >= 0.3
+
+
+def test_a_time_step_above_the_converged_range_warns_and_a_diverging_walk_says_so(tmp_path, capsys):
+    """walk --time-step 0.01 was accepted silently and its diverging control loop reported as an ordinary
+    fall: now one warning line before the walk, 'DIVERGED' on the console and 'diverged' in the record; the
+    walk is a result (exit 0)."""
+    code = main(["walk", "--time-step", "0.01", "--distance", "1", "--no-animation", "--out", str(tmp_path / "w")])
+    err = capsys.readouterr()
+    assert code == 0
+    assert [line for line in err.err.splitlines() if line.startswith("warning:")] == [
+        "warning: --time-step 0.01 is above 2 ms, beyond the steps at which the default gait's walk converges "
+        "(docs/RESULTS.md, 'Time step'); from 5 ms its control loop diverges, which ends an episode as 'diverged'"]
+    assert err.out.startswith("DIVERGED (the control loop diverged")
+    record = json.loads((tmp_path / "w" / "result.json").read_text())
+    assert record["termination"] == "diverged" and record["fell"]

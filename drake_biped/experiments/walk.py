@@ -144,7 +144,8 @@ def run(settings: WalkSettings, out: Path, client=None, progress: bool = True):
 
 def summary_lines(result) -> list[str]:
     """What `drake-biped walk` prints: how the walk ended, its gait, its energy, its speed of simulation."""
-    status = f"FELL ({result.fall_reason})" if result.fell else f"ended: {result.termination}"
+    status = ((f"DIVERGED ({result.fall_reason})" if result.termination == "diverged" else f"FELL ({result.fall_reason})")
+              if result.fell else f"ended: {result.termination}")
     cmt = "n/a" if result.cost_of_transport is None else f"{result.cost_of_transport:.3f}"
     cmt_kg = "n/a" if result.cost_of_transport_per_kg is None else f"{result.cost_of_transport_per_kg:.3f}"
     if result.step_period_s is None or result.step_length_m is None:  # they need three touchdowns
