@@ -107,6 +107,11 @@ def add_biped(
     return PlantHandles(plant, scene_graph, link_masses_of(plant))
 
 
+# A level-then-slope ground's boxes: the level part from GROUND_BEHIND_M (behind the start) to the slope's foot,
+# the slope GROUND_AHEAD_M beyond it, both GROUND_DEPTH_M deep.
+GROUND_BEHIND_M, GROUND_AHEAD_M, GROUND_DEPTH_M = -100.0, 2000.0, 10.0
+
+
 def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
     """Ground as half-space(s) for contact plus thin boxes so Meshcat can draw it."""
     friction = CoulombFriction(ground.friction, ground.friction)
@@ -119,6 +124,16 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
         props = ProximityProperties()
         AddContactMaterial(friction=friction, properties=props)
         plant.RegisterCollisionGeometry(world, X, HalfSpace(), name, props)
+
+    def add_ground_box(name: str, angle: float, x0: float, x1: float) -> None:
+        # A box whose top face is the ground from x0 to x1 (measured along the ground), rising at `angle` from
+        # (x0, 0, 0), GROUND_DEPTH_M deep.
+        props = ProximityProperties()
+        AddContactMaterial(friction=friction, properties=props)
+        rotation = RotationMatrix.MakeYRotation(-angle)
+        centre = rotation.multiply(np.array([0.5 * (x1 - x0), 0.0, -0.5 * GROUND_DEPTH_M])) + np.array([x0, 0.0, 0.0])
+        plant.RegisterCollisionGeometry(world, RigidTransform(rotation, centre), Box(x1 - x0, 10.0, GROUND_DEPTH_M),
+                                        name, props)
 
     def add_visual(name: str, angle: float, x0: float, x1: float, z0: float) -> None:
         length = (x1 - x0) / math.cos(angle)
@@ -149,9 +164,12 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
         add_plane("ground", ground.slope_rad, 0.0)
         add_visual("ground_visual", ground.slope_rad, -5.0, visual_end, -5.0 * math.tan(ground.slope_rad))
     else:
-        # Level-then-ascending: the union of two half-spaces is exactly max(0, (x - x0) tan s).
-        add_plane("ground_level", 0.0, 0.0)
-        add_plane("ground_slope", ground.slope_rad, ground.level_length_m)
+        # Level-then-ascending, max(0, (x - x0) tan s): each surface a box that is the ground only where that
+        # surface is, meeting at the kink x0. Two half-spaces (their union is the same ground) both reach under
+        # the other part, so a foot sphere within p / tan s of the kink (5 cm at 1 mm and 0.02 rad) met the
+        # ground twice; measured on the climbing gaits' 10 m (2 m level), C_mt moves by 0.14 % and 0.10 %.
+        add_ground_box("ground_level", 0.0, GROUND_BEHIND_M, ground.level_length_m)
+        add_ground_box("ground_slope", ground.slope_rad, ground.level_length_m, ground.level_length_m + GROUND_AHEAD_M)
         add_visual("ground_level_visual", 0.0, -5.0, ground.level_length_m, 0.0)
         add_visual("ground_slope_visual", ground.slope_rad, ground.level_length_m, visual_end, 0.0)
 

@@ -192,6 +192,41 @@ def test_a_ground_is_one_surface_wherever_it_is_one_surface():
     assert len(_collision_grounds(Ground(slope_rad=0.02, level_length_m=5.0))) == 2  # a level part, then a slope
 
 
+@pytest.mark.parametrize("offset_m", [-0.04, -0.02, 0.02, 0.04])
+def test_near_the_kink_a_foot_meets_one_surface(offset_m):
+    """Level for 2 m, then 0.02 rad: a foot sphere 2-4 cm either side of the kink, 0.5 mm into the ground
+    there, meets the ground once, at the depth it has into the surface above it (two half-spaces met it twice
+    within 5 cm: the level one reaches under the slope and the slope one under the level part)."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_biped.diagram import initial_state
+    from drake_biped.kinematics import leg_points
+    from drake_biped.params import EpisodeConfig
+
+    ground = Ground(slope_rad=0.02, level_length_m=2.0)
+    builder = DiagramBuilder()
+    handles = add_biped(builder, ground, 1e-3)
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    plant = handles.plant
+    q, *_ = initial_state(EpisodeConfig())
+    q = q.copy()
+    q[1] += 0.3  # lift the robot; then put the right heel's sphere where it is wanted
+    heel = leg_points(q[0], q[1], q[2], q[6], q[7], q[8])
+    x = 2.0 + offset_m
+    q[0] += x - heel.heel_x
+    q[1] += ground.height(x) - 0.0005 - heel.heel_z
+    plant.SetPositions(plant.GetMyMutableContextFromRoot(context), q)
+    query = handles.scene_graph.get_query_output_port().Eval(handles.scene_graph.GetMyContextFromRoot(context))
+    inspector = handles.scene_graph.model_inspector()
+    heel_id = min(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("right_foot")),
+                  key=lambda g: inspector.GetPoseInFrame(g).translation()[0])  # the heel: the sphere behind
+    pairs = [p for p in query.ComputePointPairPenetration() if heel_id in (p.id_A, p.id_B)]
+    assert len(pairs) == 1
+    surface_angle = ground.slope_at(x)
+    assert pairs[0].depth == pytest.approx(0.0005 * math.cos(surface_angle), abs=2e-5)
+
+
 def test_a_walk_with_a_level_length_on_level_ground_is_the_walk_without_it():
     from drake_biped.episode import run_episode
     from drake_biped.params import EpisodeConfig, SimulationParams
