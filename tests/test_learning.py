@@ -176,3 +176,21 @@ def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client)
     other = compare_learners.CompareSettings(config.override({"sim.distance_m": 0.7}), str(tmp_path / "map"))
     with pytest.raises(ParameterError, match="made for another gait"):
         other.read_map()
+
+
+@pytest.mark.parametrize("content, named", [
+    ("[" * 50_000 + "]" * 50_000, "nested too deeply"),
+    (b"\xff\xfe", "not UTF-8 text"),
+    ("{not json", "not valid JSON"),
+])
+def test_a_damaged_trial_record_is_named_with_what_to_do(tmp_path, content, named):
+    """A trial record nested 50,000 deep raised a bare RecursionError, one not UTF-8 a UnicodeDecodeError
+    without the remedy: each is one ParameterError naming the file, what is wrong and what to do."""
+    (tmp_path / "trials").mkdir()
+    path = tmp_path / "trials" / "trial_0.json"
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    with pytest.raises(ParameterError) as info:
+        Trial(tmp_path, 0, _settings())
+    message = str(info.value)
+    assert str(path) in message and named in message and "delete it to run trial 0 again" in message
+    assert path.read_bytes() == (content if isinstance(content, bytes) else content.encode())  # never overwritten

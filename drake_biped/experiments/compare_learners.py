@@ -8,7 +8,6 @@ Each learner's run is an ordinary learning run in OUT/NAME/ (the same records, f
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -90,7 +89,7 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
     with client_or_local(client) as c:
         for name in settings.learners:
             record = learning.run(_learning_settings(settings, name), out / name, c, progress=progress)
-            wall = json.loads((out / name / "run.json").read_text())["learning_wall_s"]
+            wall = read_json(out / name / "run.json", "compare-learners")["learning_wall_s"]
             rows[name] = {**compare(record, best), "wall_s": wall}
             curves[name] = [t["episodes"] for t in record["trials"]]
     record = {

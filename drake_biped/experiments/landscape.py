@@ -3,7 +3,6 @@ landscape.png, for the policy variances asked. Reads records only; simulates not
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,9 +39,11 @@ def run(settings: LandscapeSettings, out: Path | None = None, client=None, progr
     path = settings.path()
     if not path.is_file():
         raise ParameterError(f"no window map at {settings.window_map} (run drake-biped window-map first)")
+    from drake_biped.records import read_json
+
     try:
-        rewards = WindowRewards.from_window_map(json.loads(path.read_text()))
-    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+        rewards = WindowRewards.from_window_map(read_json(path, "landscape: window map"))
+    except (KeyError, TypeError) as exc:
         raise ParameterError(f"{path} is not a window map ({exc})") from None
     record = landscape(rewards, list(settings.variances), samples=settings.samples, seed=settings.seed,
                        starts=[tuple(s) for s in settings.starts])

@@ -26,7 +26,6 @@ means no torque-free period, as in the paper.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,7 +45,7 @@ from drake_biped.paper import (
     TABLE_II,
 )
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
-from drake_biped.records import write_atomic
+from drake_biped.records import read_json, write_atomic
 from drake_biped.versions import versions
 
 __all__ = ["LearningSettings", "Trial", "best_learned_trial", "check_learning_record", "make_settings", "reward", "run", "run_learning",
@@ -116,11 +115,11 @@ class Trial:
         remedy = (f"restore it, or delete it to run trial {self.index} again from its first episode (the same "
                   "seed gives the same episodes; the other trials are kept)")
         try:
-            record = json.loads(self.path.read_text())
+            record = read_json(self.path, "trial record")
             learner_from_state(record["learner"])
             record["episodes"][:0]
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise ParameterError(f"{self.path}: not valid JSON ({exc}); {remedy}") from None
+        except ParameterError as exc:
+            raise ParameterError(f"{exc}; {remedy}") from None
         except (KeyError, TypeError, ValueError) as exc:
             raise ParameterError(f"{self.path}: not a trial record ({type(exc).__name__}: {exc}); {remedy}") from None
         return record
@@ -395,7 +394,7 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     if ev.get("reduction") is not None:
         lines.append(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
                      f"{ev['learned_mean_cost_of_transport']:.3f}: {saving_words(ev['reduction'])}")
-    run_log = json.loads((out / "run.json").read_text())
+    run_log = read_json(out / "run.json", "learn")
     this = run_log["sessions"][-1]
     if this["episodes_per_min"]:
         lines.append(f"{this['episodes']} episodes in {this['learning_wall_s']:.0f} s "

@@ -33,7 +33,6 @@ reuses every finished experiment and resumes the unfinished one.
 from __future__ import annotations
 
 import dataclasses
-import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -42,7 +41,7 @@ from typing import Any
 
 from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import PAPER_CPG, EpisodeConfig, InitialConditions, ParameterError, TorqueFreeWindow
-from drake_biped.records import read_kept, write_atomic
+from drake_biped.records import read_json, read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
@@ -297,7 +296,7 @@ class Reproduction:
         def run(folder: Path) -> dict:
             record = learning.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler)
             ev = record["evaluation"]
-            run_log = json.loads((folder / "run.json").read_text())
+            run_log = read_json(folder / "run.json", "reproduce")
             return {"evaluation": ev, "episodes_per_min": run_log["episodes_per_min"]}
 
         return self.experiment(name, {k: settings[k] for k in ("trials", "episodes", "learner", "config")}, run)
@@ -345,7 +344,7 @@ class Reproduction:
         for source in ("learn", "learn_variant") if "learned" in self.profile.floquet_gaits else ():
             # the learned window: the paper's settings' if they learned one
             try:
-                row = best_learned_trial(json.loads((self.out / source / "learning.json").read_text()), source)
+                row = best_learned_trial(read_json(self.out / source / "learning.json", "reproduce"), source)
             except (OSError, ValueError):
                 continue
             windows["learned"] = (max(0.0, float(row["t1"])), max(0.0, float(row["t2"])))
@@ -475,7 +474,7 @@ class Reproduction:
 
         p, config = self.profile, self.learner_level
         try:
-            row = best_learned_trial(json.loads((self.out / self.folder("learner_learn") / "learning.json").read_text()))
+            row = best_learned_trial(read_json(self.out / self.folder("learner_learn") / "learning.json", "reproduce"))
             source, window = f"learned (trial {row['trial']})", (max(0.0, float(row["t1"])), float(row["t2"]))
         except (OSError, ValueError):
             best = read_kept(self.out / self.folder("learner_window_map") / "summary.json")["best"]

@@ -21,7 +21,6 @@ episode, resumed on rerun) and the check episodes are kept in OUT/checks/ and re
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -57,9 +56,11 @@ def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
     trial_path = path.parent / "trials" / f"trial_{row['trial']}.json"
     try:
-        state = json.loads(trial_path.read_text())["learner"]
+        state = read_json(trial_path, f"--policy {path}: trial {row['trial']}'s learner state")["learner"]
         GarbLearner.from_state(state)
-    except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+    except ParameterError:
+        raise
+    except (KeyError, TypeError, ValueError) as exc:
         raise ParameterError(f"--policy {path}: cannot read trial {row['trial']}'s learner state from "
                              f"{trial_path} ({exc})") from None
     source = {"learning": str(path), "trial": row["trial"], "level_cost_of_transport": row["cost_of_transport"],
