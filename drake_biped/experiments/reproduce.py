@@ -90,7 +90,7 @@ class Profile:
 # The quick run: the walk, the cheap verdicts (Table III and the paper gait fall in two steps), the shipped
 # full run's learned windows walked again, a few learning episodes and one Floquet orbit. What it is too small
 # to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
-QUICK = Profile("quick", 10.0, 2, 1, (2, 3), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
+QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 2.0, floquet_epsilons=(1e-7, 1e-6, 1e-5), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
