@@ -135,6 +135,21 @@ def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]
     return [{"key": k, "what": a, "paper": b, "ours": c, "verdict": d} for k, (a, b, c, d) in zip(CLAIM_KEYS, verdicts)]
 
 
+def walk_section(walk: dict[str, Any]) -> list[str]:
+    """The report's section on the default gait's walk (`walk/`), from its summary."""
+    return [
+        "## The walk (`walk/`)",
+        "",
+        f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
+        f"{_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
+        f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
+        "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
+        "",
+        "![walk](walk/walk.png)",
+        "",
+    ]
+
+
 def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any]) -> tuple[str, list]:
     LEVEL_WINDOW = tuple(s["push_margin"]["settings"]["window"])  # the window compared with none
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
@@ -214,15 +229,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         "![verdicts](report_summary.png)",
         "",
-        "## The walk (`walk/`)",
-        "",
-        f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
-        f"{_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
-        f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
-        "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
-        "",
-        "![walk](walk/walk.png)",
-        "",
+        *walk_section(walk),
         "## Grid search, Table IV (`grid/`)",
         "",
         f"{grid['points']} points over Table IV's CPG ranges and the initiation, level ground, one episode each: "
@@ -491,6 +498,8 @@ def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: 
 
 
 def _profile_text(p: Any) -> str:
+    if getattr(p, "steps", ()):  # a profile of a few steps says which
+        return f"steps: {', '.join(p.steps)}; learning {p.learn[0]}×{p.learn[1]} episodes"
     return (f"learning {p.learn[0]}×{p.learn[1]} and {p.learn_variant[0]}×{p.learn_variant[1]} episodes, "
             f"{p.stability_trials} trials per stability cell, slope learning {p.slope[0]}×{p.slope[1]}, "
             f"grid {p.grid_points} points per Table IV range")
@@ -614,15 +623,7 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         "",
         "![verdicts](report_summary.png)",
         "",
-        "## The walk (`walk/`)",
-        "",
-        f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
-        f"{_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
-        f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
-        "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
-        "",
-        "![walk](walk/walk.png)",
-        "",
+        *walk_section(walk),
         "## The full run's learned windows, walked again here (`full_run/`)",
         "",
         "| learning run | window (s) | C_mt recorded | C_mt here | same |",
