@@ -483,14 +483,10 @@ class CpgWalkingController(LeafSystem):
                  masses: LinkMasses = TABLE_I_MASSES):
         """`masses`: the model's link masses (`model.link_masses_of`), for the centre of mass."""
         super().__init__()
-        self._masses = masses
         self._body = body_vector(masses)
         self._row = np.zeros(1 + _TD)  # the kernel's touchdown row: index, then TOUCHDOWN's fields
         # Structure: fixed for the life of the system.
         self._structure = self.structure_key(config)
-        self._ground = config.ground
-        self._dt = config.sim.control_period_s
-        self._state_lag = config.sim.time_step_s  # see "Timing" above
         self._capacity = touchdown_capacity(config)
         self.configure(config)
 
@@ -506,7 +502,7 @@ class CpgWalkingController(LeafSystem):
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
         self.DeclareStateOutputPort("actuation", self._torque_group)
         self.DeclareStateOutputPort("controller_state", self._state_group)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(config.sim.control_period_s, 0.0, self._update)
 
     @staticmethod
     def structure_key(config: EpisodeConfig) -> tuple:
@@ -521,7 +517,6 @@ class CpgWalkingController(LeafSystem):
         if self.structure_key(config) != self._structure:
             raise ValueError("configure: this controller was built for another ground, time step, control "
                              "period, time limit or minimum step time; build a new diagram")
-        self._config = config
         self._law = law_vector(config)
 
     def get_input_port_plant_state(self):
