@@ -13,9 +13,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drake_biped.analysis.series import moving_average, period  # noqa: E402
-from drake_biped.kinematics import leg_points  # noqa: E402
+from drake_biped.kinematics import B_TORSO_COM_X, B_TORSO_COM_Z, TABLE_I_BODY, leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
-from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_V, TABLE_V_REDUCTION  # noqa: E402
+from drake_biped.paper import TABLE_V, TABLE_V_REDUCTION  # noqa: E402
 from drake_biped.records import atomic_file, save_figure, write_text_atomic  # noqa: E402
 
 JOINTS = ("left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle")
@@ -74,23 +74,27 @@ def walk_figure(trajectory: dict, path: str | Path, title: str = "") -> None:
     plt.close(fig)
 
 
-def _skeleton(q: np.ndarray) -> dict[str, np.ndarray]:
+def _skeleton(q: np.ndarray, body=TABLE_I_BODY) -> dict[str, np.ndarray]:
     x, z, pitch = q[0], q[1], q[2]
-    torso_top = (x - TABLE_I_LENGTHS_M["torso"] * np.sin(pitch), z + TABLE_I_LENGTHS_M["torso"] * np.cos(pitch))
+    # the torso drawn from the base to twice its centre of mass (its top, for a uniform torso)
+    cx, cz = body[B_TORSO_COM_X], body[B_TORSO_COM_Z]
+    top = 2.0 * cx, 2.0 * cz
+    torso_top = (x + top[0] * np.cos(pitch) - top[1] * np.sin(pitch), z + top[0] * np.sin(pitch) + top[1] * np.cos(pitch))
     lines = {"torso": np.array([[x, z], torso_top])}
     for side, i in (("left", 3), ("right", 6)):
-        p = leg_points(x, z, pitch, q[i], q[i + 1], q[i + 2])
+        p = leg_points(x, z, pitch, q[i], q[i + 1], q[i + 2], body)
         lines[side] = np.array(
-            [[x, z], [p.knee_x, p.knee_z], [p.ankle_x, p.ankle_z], [p.heel_x, p.heel_z], [p.toe_x, p.toe_z],
-             [p.ankle_x, p.ankle_z]]
+            [[p.hip_x, p.hip_z], [p.knee_x, p.knee_z], [p.ankle_x, p.ankle_z], [p.heel_x, p.heel_z],
+             [p.toe_x, p.toe_z], [p.ankle_x, p.ankle_z]]
         )
     return lines
 
 
 def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: int = 15,
-                   max_frames: int = 300) -> None:
+                   max_frames: int = 300, body=TABLE_I_BODY) -> None:
     """A planar stick-figure GIF of the walk, the camera following the hip: drawn in the hip's frame
-    (axes fixed, so each frame redraws only the robot, the ground and the metre marks), x in the label."""
+    (axes fixed, so each frame redraws only the robot, the ground and the metre marks), x in the label.
+    `body`: the robot's (kinematics.BODY), the shipped one's by default."""
     from PIL import Image
 
     t = trajectory["time"]
@@ -119,7 +123,7 @@ def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: 
         gx = np.linspace(x0 - 0.8, x0 + 0.8, 50)
         gz = height(gx)
         z0 = gz.min()
-        for name, pts in _skeleton(qi).items():
+        for name, pts in _skeleton(qi, body).items():
             artists[name].set_data(pts[:, 0] - x0, pts[:, 1] - z0)
         ground_line.set_data(gx - x0, gz - z0)
         mx = np.arange(np.ceil(x0 - 0.8), np.floor(x0 + 0.8) + 1.0)

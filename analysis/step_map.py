@@ -32,7 +32,7 @@ from pydrake.systems.analysis import Simulator
 from drake_biped import controller as ctl
 from drake_biped.diagram import build_diagram
 from drake_biped.episode import reset_context
-from drake_biped.kinematics import SHANK_M, THIGH_M, leg_points
+from drake_biped.kinematics import B_ANKLE_X, B_ANKLE_Z, B_KNEE_X, B_KNEE_Z, TABLE_I_BODY, leg_points
 from drake_biped.model import JOINTS_OF_A_LEG, joint_index
 from drake_biped.params import EpisodeConfig, ParameterError
 
@@ -55,10 +55,18 @@ def _legs(stance_right: bool) -> tuple[list[int], list[int]]:
     return ([joint_index(stance, j) for j in JOINTS_OF_A_LEG], [joint_index(swing, j) for j in JOINTS_OF_A_LEG])
 
 
-def section_value(q: np.ndarray, stance_right: bool) -> float:
-    """g = x_hip − x_stance_ankle (m): negative after touchdown, zero at the section."""
+def _turned(body, x_slot: int, z_slot: int, angle: float) -> tuple[float, float]:
+    """d/d(angle) of a joint's offset (body[x_slot], body[z_slot]) turned by `angle` in the x-z plane: the
+    (x, z) velocity of the joint per unit rate of its parent link."""
+    c, s = math.cos(angle), math.sin(angle)
+    return -body[x_slot] * s - body[z_slot] * c, body[x_slot] * c - body[z_slot] * s
+
+
+def section_value(q: np.ndarray, stance_right: bool, body=TABLE_I_BODY) -> float:
+    """g = x_base − x_stance_ankle (m), the torso frame's origin (the hips, in the shipped model) ahead of the
+    stance ankle: negative after touchdown, zero at the section."""
     st = _legs(stance_right)[0]
-    leg = leg_points(q[0], q[1], q[2], q[3 + st[0]], q[3 + st[1]], q[3 + st[2]])
+    leg = leg_points(q[0], q[1], q[2], q[3 + st[0]], q[3 + st[1]], q[3 + st[2]], body)
     return float(q[0] - leg.ankle_x)
 
 
@@ -133,20 +141,23 @@ class SectionMap:
         # the template's stance foot: ankle point, foot angle, and their rates
         th0, dth0 = tq[2] + tq[hip], tv[2] + tv[hip]
         sh0, dsh0 = th0 - tq[knee], dth0 - tv[knee]
-        stance = leg_points(tq[0], tq[1], tq[2], tq[hip], tq[knee], tq[ankle])
+        body = self._parts.body
+        stance = leg_points(tq[0], tq[1], tq[2], tq[hip], tq[knee], tq[ankle], body)
         ax, az = stance.ankle_x, stance.ankle_z
-        dax = tv[0] + THIGH_M * math.cos(th0) * dth0 + SHANK_M * math.cos(sh0) * dsh0
-        daz = tv[1] + THIGH_M * math.sin(th0) * dth0 + SHANK_M * math.sin(sh0) * dsh0
+        (kx0, kz0), (ax0, az0) = _turned(body, B_KNEE_X, B_KNEE_Z, th0), _turned(body, B_ANKLE_X, B_ANKLE_Z, sh0)
+        dax = tv[0] + kx0 * dth0 + ax0 * dsh0
+        daz = tv[1] + kz0 * dth0 + az0 * dsh0
         foot, dfoot = sh0 + tq[ankle], dsh0 + tv[ankle]
         pitch, th, dpitch, dth = z[0], z[1], z[5], z[6]
         sh, dsh = th - tq[knee], dth - tv[knee]
         plant = template.plant.copy()
         q, v = plant[:9], plant[9:]
         q[2], q[hip], q[ankle] = pitch, th - pitch, foot - sh
-        leg = leg_points(0.0, 0.0, pitch, q[hip], q[knee], q[ankle])  # the ankle relative to the hip
+        leg = leg_points(0.0, 0.0, pitch, q[hip], q[knee], q[ankle], body)  # the ankle relative to the base
         q[0], q[1] = ax - leg.ankle_x, az - leg.ankle_z
-        v[0] = dax - THIGH_M * math.cos(th) * dth - SHANK_M * math.cos(sh) * dsh
-        v[1] = daz - THIGH_M * math.sin(th) * dth - SHANK_M * math.sin(sh) * dsh
+        (kx, kz), (ax1, az1) = _turned(body, B_KNEE_X, B_KNEE_Z, th), _turned(body, B_ANKLE_X, B_ANKLE_Z, sh)
+        v[0] = dax - kx * dth - ax1 * dsh
+        v[1] = daz - kz * dth - az1 * dsh
         v[2], v[hip], v[ankle] = dpitch, dth - dpitch, dfoot - dsh
         for k, i in enumerate(sw):
             q[3 + i], v[3 + i] = z[2 + k], z[7 + k]
@@ -168,7 +179,8 @@ class SectionMap:
         knee = q[3 + _legs(self.template.stance_right)[0][1]]
         th = self.pack(self.template)[1]
         grad = np.zeros(len(self.names))
-        grad[1] = -(THIGH_M * math.cos(th) + SHANK_M * math.cos(th - knee))
+        body = self._parts.body
+        grad[1] = -(_turned(body, B_KNEE_X, B_KNEE_Z, th)[0] + _turned(body, B_ANKLE_X, B_ANKLE_Z, th - knee)[0])
         return grad
 
     # --- simulation --------------------------------------------------------------------------------
@@ -214,13 +226,13 @@ class SectionMap:
             snap = self._advance(k)
             if snap is None or k > k_limit:
                 return None
-        previous, g_prev = snap, section_value(snap.plant, snap.stance_right)
+        previous, g_prev = snap, section_value(snap.plant, snap.stance_right, self._parts.body)
         while True:
             k += 1
             snap = self._advance(k)
             if snap is None or k > k_limit:
                 return None
-            g = section_value(snap.plant, snap.stance_right)
+            g = section_value(snap.plant, snap.stance_right, self._parts.body)
             if g_prev < 0.0 <= g:
                 f = -g_prev / (g - g_prev)
                 mix = Snapshot(

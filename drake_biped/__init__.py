@@ -41,11 +41,14 @@ _API = {
     "DEFAULT_CPG": "drake_biped.params",
     "DEFAULT_GAIT": "drake_biped.params",
     "PAPER_CPG": "drake_biped.params",
+    "RobotModel": "drake_biped.params",
     # shipped gaits
     "load_gait": "drake_biped.resources",
     "gait_names": "drake_biped.resources",
+    "shipped_model_file": "drake_biped.resources",
     # simulation
     "build_plant": "drake_biped.model",
+    "body_of_model": "drake_biped.model",
     "ModelError": "drake_biped.model",
     "JOINT_NAMES": "drake_biped.model",
     "build_diagram": "drake_biped.diagram",

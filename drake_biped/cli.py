@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from drake_biped.experiments.gait_search import OBJECTIVES
 from drake_biped.model import ModelError
 from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow
 
@@ -83,7 +84,7 @@ _count = integer(1)
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
     p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, coasting, "
-                   "coasting_garb, coasting_wide, paper) or a JSON file of EpisodeConfig fields (cpg, gait, "
+                   "coasting_garb, coasting_wide, paper, paper_entrained) or a JSON file of EpisodeConfig fields (cpg, gait, "
                    "initial, ...) or a result.json")
     p.add_argument("--distance", type=number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
     p.add_argument("--max-time", type=number("positive"),
@@ -100,6 +101,25 @@ def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False
         p.add_argument("--level-length", type=number("nonnegative"),
                        help="level ground for this many metres, then the slope (default: none, the slope everywhere)")
     p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default: 0)")
+    _add_model_option(p)
+
+
+def _add_model_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--model", help="the robot: a URDF or SDFormat file with the shipped model's link and joint "
+                   "names (default: the shipped biped, or the --params file's); its content travels with the "
+                   "episodes and result.json records its name and SHA-256")
+
+
+def _with_model(config: EpisodeConfig, model_file: str | None) -> EpisodeConfig:
+    """`config` with the --model file's robot, checked (parsed and its body read) before any work starts."""
+    from drake_biped.model import body_of_model
+    from drake_biped.params import RobotModel
+
+    if model_file is not None:
+        config = config.replace(model=RobotModel.from_file(model_file))
+    if config.model is not None:
+        body_of_model(config.model)  # ModelError: one line, exit 2
+    return config
 
 
 # The longest time step (and control period) at which the default gait's walk has been measured to converge.
@@ -122,7 +142,7 @@ def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
         changes["ground.slope_rad"] = args.slope
     if args.level_length is not None:
         changes["ground.level_length_m"] = args.level_length
-    config = config.override(changes)
+    config = _with_model(config.override(changes), args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
         print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
               "steps at which the default gait's walk converges (docs/RESULTS.md, 'Time step'); from 5 ms its "
@@ -209,6 +229,8 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
         from drake_biped.resources import load_gait
 
         config = None if args.params is None else load_gait(args.params)
+        if args.model is not None:
+            config = _with_model(config or EpisodeConfig(), args.model)
         settings = time_step.TimeStepSettings(tuple(args.steps), args.reference, args.distance, config,
                                               "Default gait" if args.params is None else f"Gait {args.params}",
                                               None if args.windows is None else tuple(args.windows))
@@ -596,14 +618,16 @@ def build_parser() -> argparse.ArgumentParser:
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
     search.add_argument("--objective", default="windows",
-                        choices=["windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape"],
+                        choices=list(OBJECTIVES),
                         help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
                              "find a walker), 'policy' (the expected reward of the paper's start policy, plus "
                              "half its best draw's), 'expected' (that expected reward alone), "
                              "'nearest' (the CPG's nearness to Table III, and surviving +-20 N pushes), 'coast' (hip off from t1 until "
                              "touchdown), 'floquet' ((1 - rho)/(1 + rho) of the period-1 orbit), 'landscape' "
                              "(the paper's start policy's expected gain on a coarse window map, half the best "
-                             "mean's up to 0.2, less 0.25 a failed 20 N push)")
+                             "mean's up to 0.2, less 0.25 a failed 20 N push), 'robust' (how far the walk is from "
+                             "holding at half the plant step, from 0.95 and 1.05 x the initiation speed and under "
+                             "+-20 N pushes; 0 once all hold)")
     search.add_argument("--policy-draws", type=_count, default=12,
                         help="draws of the paper's start policy the 'policy' and 'expected' objectives walk "
                              "(default 12; a draw with t2 <= t1 is no window and costs no episode)")
@@ -617,6 +641,7 @@ def build_parser() -> argparse.ArgumentParser:
     ts.add_argument("--distance", type=number("positive"), default=10.0, help="walk this far (m); default 10")
     ts.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
                     "default gait. Its own time step is replaced by each of --steps")
+    _add_model_option(ts)
     ts.add_argument("--windows", type=windows,
                     help="the windows compared with none, T1-T2 in s, comma-separated (default "
                          "0.1-0.4,0.2-0.5,0.3-0.6,0.35-0.65,0.2-0.7)")

@@ -58,7 +58,7 @@ from drake_biped.gait import (
     touchdown_rule,
 )
 from drake_biped.jit import njit
-from drake_biped.kinematics import TABLE_I_MASSES, LinkMasses, body_vector, center_of_mass_k, leg_points_k
+from drake_biped.kinematics import BODY, TABLE_I_BODY, center_of_mass_k, leg_points_k
 from drake_biped.layout import Field, VectorLayout
 from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
 from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
@@ -66,7 +66,8 @@ from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
 # The "controller_state" discrete group, declared once; the update below uses the offsets generated here.
 CONTROLLER_STATE = VectorLayout("controller_state", (
     Field("cpg_phase", 1, "CPG phase gamma (rad)"),
-    Field("stance_right", 1, "1.0 when the right leg is the stance leg"),
+    Field("stance_right", 1, "1.0 when the right leg is the stance leg (its hip balances the torso)"),
+    Field("contact_right", 1, "1.0 when the right foot landed last (the stance leg under phase_reading 'reset')"),
     Field("step_start_s", 1, "T_n, the last touchdown: when the swing foot's clearance crossed the touchdown "
                              "height, interpolated within the control period (plant-state time, s)"),
     Field("liftoff_angle_rad", 1, "swing thigh world angle at T_n (rad)"),
@@ -95,6 +96,7 @@ N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
 GAMMA, STANCE_RIGHT, STEP_START, LIFTOFF_ANGLE = _o("cpg_phase"), _o("stance_right"), _o("step_start_s"), \
     _o("liftoff_angle_rad")
+CONTACT_RIGHT = _o("contact_right")
 STEP_COUNT, INTEGRAL, GATE, FALL = _o("step_count"), _o("hip_integral"), _o("torque_free"), _o("fall_code")
 COM_X, TARGET_X, DONE, STATE_TIME = _o("com_x_m"), _o("target_x_m"), _o("done"), _o("state_time_s")
 Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
@@ -156,6 +158,7 @@ LAW = VectorLayout("law", (
     Field("swing_amplitude_rad", 1, "alpha u_a / u_r"),
     Field("integrated", 1, "1.0 for swing_reading 'integrated', 0.0 for 'anchored'"),
     Field("predicted_swap", 1, "1.0 for swap_timing 'predicted', 0.0 for 'update'"),
+    Field("entrained", 1, "1.0 for phase_reading 'entrained', 0.0 for 'reset'"),
     Field("swing_offset_rad", 1, ""), Field("hip_kp", 1, ""), Field("hip_kd", 1, ""), Field("hip_ki", 1, ""),
     Field("placement_gain", 1, ""), Field("placement_velocity_gain", 1, ""),
     Field("torso_kp", 1, ""), Field("torso_kd", 1, ""), Field("torso_pitch_rad", 1, ""),
@@ -173,6 +176,7 @@ L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("control_pe
                                                                     "u_eta", "u_r", "kappa"))
 L_AMPLITUDE, L_INTEGRATED, L_PREDICTED, L_OFFSET = (_o(n) for n in ("swing_amplitude_rad", "integrated",
                                                                    "predicted_swap", "swing_offset_rad"))
+L_ENTRAINED = _o("entrained")
 L_HIP_KP, L_HIP_KD, L_HIP_KI, L_PLACE, L_PLACE_V = (_o(n) for n in ("hip_kp", "hip_kd", "hip_ki", "placement_gain",
                                                                    "placement_velocity_gain"))
 L_TORSO_KP, L_TORSO_KD, L_TORSO_PITCH, L_KNEE, L_STANCE_KNEE = (_o(n) for n in (
@@ -200,6 +204,7 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     put("swing_amplitude_rad", c.swing_amplitude_rad)
     put("integrated", 1.0 if g.swing_reading == "integrated" else 0.0)
     put("predicted_swap", 1.0 if g.swap_timing == "predicted" else 0.0)
+    put("entrained", 1.0 if g.phase_reading == "entrained" else 0.0)
     for name in ("swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain", "placement_velocity_gain",
                  "torso_kp", "torso_kd", "torso_pitch_rad", "stance_knee_torque", "ankle_kp", "ankle_kd"):
         put(name, getattr(g, name))
@@ -223,7 +228,8 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
 TOUCHED, FELL, DONE_BIT = 1, 2, 4
 
 # Leg points tuple (kinematics.leg_points_k): the slots the update reads.
-_KNEE_X, _KNEE_Z, _ANKLE_X, _HEEL_X, _HEEL_Z, _TOE_X, _TOE_Z, _THIGH, _FOOT = 0, 1, 2, 4, 5, 6, 7, 8, 10
+_KNEE_X, _KNEE_Z, _ANKLE_X, _HEEL_X, _HEEL_Z, _TOE_X, _TOE_Z, _THIGH, _FOOT, _HIP_X, _HIP_Z = 0, 1, 2, 4, 5, 6, 7, 8, 10, \
+    11, 12
 
 
 @njit
@@ -273,7 +279,8 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
         st_i, sw_i = Q_HIP_RIGHT, Q_HIP_LEFT
     else:
         st_i, sw_i = Q_HIP_LEFT, Q_HIP_RIGHT
-    px, pitch, pitch_rate = q[0], q[2], v[2]
+    pitch, pitch_rate = q[2], v[2]
+    hip_ahead = stance[_HIP_X] - stance[_ANKLE_X]  # the hip joint ahead of the stance ankle
     # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
     elapsed = now - s[STEP_START]
 
@@ -285,10 +292,10 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
     if law[L_INTEGRATED] != 0.0:
         # Table III's zeta drives the swing as printed: the reference angle is its integral from the
         # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
-        offset = law[L_OFFSET] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], px - stance[_ANKLE_X], v[0])
+        offset = law[L_OFFSET] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], hip_ahead, v[0])
         reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
     else:
-        target = law[L_AMPLITUDE] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], px - stance[_ANKLE_X], v[0])
+        target = law[L_AMPLITUDE] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], hip_ahead, v[0])
         reference = swing_reference(gamma, s[LIFTOFF_ANGLE], target)
     swing_rate = pitch_rate + v[sw_i]
     angle_error = reference - swing[_THIGH]
@@ -368,6 +375,7 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     s[PREV_PITCH] = pitch
     left = leg_points_k(body, px, pz, pitch, q[3], q[4], q[5])
     right = leg_points_k(body, px, pz, pitch, q[6], q[7], q[8])
+    entrained = law[L_ENTRAINED] != 0.0
     stance_right = s[STANCE_RIGHT] > 0.5
     if stance_right:
         st_i, sw_i = Q_HIP_RIGHT, Q_HIP_LEFT
@@ -375,24 +383,34 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     else:
         st_i, sw_i = Q_HIP_LEFT, Q_HIP_RIGHT
         stance, swing = left, right
+    # The legs by contact (the foot that landed last, and the other): the same as the roles but under the
+    # entrained phase reading, where the phase swaps the roles and a touchdown only marks T_n.
+    contact_right = s[CONTACT_RIGHT] > 0.5
+    if contact_right:
+        cst_i, csw_i = Q_HIP_RIGHT, Q_HIP_LEFT
+        c_stance, c_swing = right, left
+    else:
+        cst_i, csw_i = Q_HIP_LEFT, Q_HIP_RIGHT
+        c_stance, c_swing = left, right
     com_x = center_of_mass_k(body, px, pz, pitch, left, right)[0]
     s[COM_X] = com_x
 
-    # Touchdown: swap the roles, reset the CPG phase (phase resetting), record the section state.
-    clearance = min(swing[_HEEL_Z] - ground_height_k(law, swing[_HEEL_X]),
-                    swing[_TOE_Z] - ground_height_k(law, swing[_TOE_X]))
-    advance = swing[_ANKLE_X] - stance[_ANKLE_X]
+    # Touchdown: record the section state and start the step's clock; under the reset reading, swap the
+    # roles and reset the CPG phase too (phase resetting).
+    clearance = min(c_swing[_HEEL_Z] - ground_height_k(law, c_swing[_HEEL_X]),
+                    c_swing[_TOE_Z] - ground_height_k(law, c_swing[_TOE_X]))
+    advance = c_swing[_ANKLE_X] - c_stance[_ANKLE_X]
     c_prev = s[PREV_CLEARANCE]
     s[PREV_CLEARANCE] = clearance
     rate_1, rate_2 = s[PREV_RATES], s[PREV_RATES + 1]
     s[PREV_RATES + 1] = rate_1
-    s[PREV_RATES] = v[sw_i] - v[st_i]  # the section rate, were the swing foot to land now
+    s[PREV_RATES] = v[csw_i] - v[cst_i]  # the section rate, were the swing foot to land now
     rule = (law[L_TOUCHDOWN], law[L_TOUCHDOWN + 1], law[L_TOUCHDOWN + 2], law[L_TOUCHDOWN + 3])
-    touched = is_touchdown_k(rule, now - s[STEP_START], clearance, advance, s[GAMMA])
+    touched = is_touchdown_k(rule, now - s[STEP_START], clearance, advance, math.pi if entrained else s[GAMMA])
     if touched:
-        stance_right = not stance_right
-        st_i, sw_i = sw_i, st_i
-        stance, swing = swing, stance
+        contact_right = not contact_right
+        cst_i, csw_i = csw_i, cst_i
+        c_stance, c_swing = c_swing, c_stance
         # T_n: the moment the clearance crossed the touchdown height, linearly between this update and
         # the previous one, when the crossing is what confirmed the touchdown (otherwise this update).
         back = 0.0
@@ -401,46 +419,60 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
         if crossed:
             back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * dt
         f = back / dt  # how far back towards the previous update T_n lies
-        angle = (1.0 - f) * (q[st_i] - q[sw_i]) + f * (q_prev[st_i - 3] - q_prev[sw_i - 3])
+        angle = (1.0 - f) * (q[cst_i] - q[csw_i]) + f * (q_prev[cst_i - 3] - q_prev[csw_i - 3])
         if crossed and math.isfinite(rate_2):
             # both rates were read before the foot reached the ground: extrapolate them to T_n
             rate = rate_1 + (rate_1 - rate_2) * (1.0 - f)
         else:
-            rate = v[st_i] - v[sw_i]
+            rate = v[cst_i] - v[csw_i]
         step_start = now - back
         n = s[STEP_COUNT]
         row[0] = n
         row[1] = step_start
         row[2] = angle
         row[3] = rate
-        row[4] = 1.0 if stance_right else 0.0
+        row[4] = 1.0 if contact_right else 0.0
         row[5] = com_x
         code |= TOUCHED
-        s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
+        s[CONTACT_RIGHT] = 1.0 if contact_right else 0.0
         s[STEP_START] = step_start
-        # the new swing thigh's world angle at T_n
-        s[LIFTOFF_ANGLE] = (1.0 - f) * swing[_THIGH] + f * (pitch_prev + q_prev[sw_i - 3])
         s[STEP_COUNT] = n + 1.0
         s[PREV_CLEARANCE] = math.inf  # the next swing foot's clearance is not yet known
         s[PREV_RATES] = math.nan
         s[PREV_RATES + 1] = math.nan
-        s[GAMMA] = advance_phase_k(law[L_UR], law[L_KAPPA], 0.0, v[st_i + ANKLE], back)  # the phase since T_n
-        s[INTEGRAL] = 0.0
-        s[TRAVEL] = back * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.5 * s[GAMMA])
+        if not entrained:
+            stance_right = contact_right
+            st_i, sw_i = cst_i, csw_i
+            stance, swing = c_stance, c_swing
+            s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
+            # the new swing thigh's world angle at T_n
+            s[LIFTOFF_ANGLE] = (1.0 - f) * swing[_THIGH] + f * (pitch_prev + q_prev[sw_i - 3])
+            s[GAMMA] = advance_phase_k(law[L_UR], law[L_KAPPA], 0.0, v[st_i + ANKLE], back)  # the phase since T_n
+            s[INTEGRAL] = 0.0
+            s[TRAVEL] = back * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.5 * s[GAMMA])
 
     # A touchdown predicted inside the coming period (the clearance extrapolated over it crosses the
     # touchdown height) swaps the roles at its own time: the period's torques blend the present roles'
     # and the new roles' by the part of the period each holds, so the swap's impulse is continuous in
     # the state. The swap itself is recorded at the next update, from the crossing it then sees.
+    # Under the entrained reading the roles swap where the phase crosses pi inside the coming period, with
+    # the same blend; the new half-cycle's phase runs on from there, and the state is the new roles' at once.
     swap = -1.0
-    if not touched and law[L_PREDICTED] != 0.0:
+    crossing = False
+    if entrained:
+        rate = phase_rate_k(law[L_UR], law[L_KAPPA], v[st_i + ANKLE])
+        if rate > 0.0 and s[GAMMA] + dt * rate >= math.pi:
+            swap = (math.pi - s[GAMMA]) / (dt * rate)
+            crossing = True
+    elif not touched and law[L_PREDICTED] != 0.0:
         swap = predicted_touchdown_k(law, s, now, clearance, c_prev, advance, v[st_i + ANKLE])
     if swap >= 0.0:
         new = s.copy()
         new[STANCE_RIGHT] = 0.0 if stance_right else 1.0
-        new[STEP_START] = now + swap * dt
         new[LIFTOFF_ANGLE] = stance[_THIGH] + swap * dt * (pitch_rate + v[st_i])
-        new[STEP_COUNT] = s[STEP_COUNT] + 1.0
+        if not crossing:
+            new[STEP_START] = now + swap * dt
+            new[STEP_COUNT] = s[STEP_COUNT] + 1.0
         # the phase and the travel from T_n: negative now, so that after the period they are the part of
         # it after T_n
         new[GAMMA] = -swap * dt * phase_rate_k(law[L_UR], law[L_KAPPA], v[sw_i + ANKLE])
@@ -451,9 +483,13 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     if swap >= 0.0:
         for i in range(TAU, TAU + 6):
             s[i] = swap * s[i] + (1.0 - swap) * new[i]
+        if crossing:
+            for i in range(N_STATE):
+                if i < TAU or i >= TAU + 6:
+                    s[i] = new[i]
 
     # Fall detection and the end of the episode.
-    if pz - ground_height_k(law, px) < law[L_FALL_HEIGHT]:
+    if left[_HIP_Z] - ground_height_k(law, left[_HIP_X]) < law[L_FALL_HEIGHT]:  # the hip joint's height
         s[FALL] = 1.0
     elif abs(pitch) > law[L_FALL_PITCH]:
         s[FALL] = 2.0
@@ -480,10 +516,14 @@ class CpgWalkingController(LeafSystem):
     """CPG + torque-free gate + hip PID + knee/ankle/stance logic for the 7-link biped."""
 
     def __init__(self, config: EpisodeConfig, initial_stance_right: bool, initial_liftoff_angle: float,
-                 masses: LinkMasses = TABLE_I_MASSES):
-        """`masses`: the model's link masses (`model.link_masses_of`), for the centre of mass."""
+                 body: np.ndarray = TABLE_I_BODY):
+        """`body`: the model's body (kinematics.BODY, `model.body_of`), for the legs' points and the centre of
+        mass."""
         super().__init__()
-        self._body = body_vector(masses)
+        body = np.asarray(body, dtype=float)
+        if body.shape != (BODY.size,):
+            raise ValueError(f"body: expected a kinematics.BODY vector of {BODY.size}, got shape {body.shape}")
+        self._body = body.copy()
         self._row = np.zeros(1 + _TD)  # the kernel's touchdown row: index, then TOUCHDOWN's fields
         # Structure: fixed for the life of the system.
         self._structure = self.structure_key(config)
@@ -493,6 +533,7 @@ class CpgWalkingController(LeafSystem):
         self._plant_state = self.DeclareVectorInputPort("plant_state", 18)
         initial = np.zeros(N_STATE)
         initial[STANCE_RIGHT] = 1.0 if initial_stance_right else 0.0
+        initial[CONTACT_RIGHT] = initial[STANCE_RIGHT]
         initial[LIFTOFF_ANGLE] = initial_liftoff_angle
         initial[TARGET_X] = math.inf
         initial[PREV_CLEARANCE] = math.inf
@@ -563,6 +604,7 @@ class CpgWalkingController(LeafSystem):
             s.SetAtIndex(Q_PREV + i, float(joint_angles[i]))
         if stance_right is not None:
             s.SetAtIndex(STANCE_RIGHT, 1.0 if stance_right else 0.0)
+            s.SetAtIndex(CONTACT_RIGHT, 1.0 if stance_right else 0.0)
         if liftoff_angle is not None:
             s.SetAtIndex(LIFTOFF_ANGLE, liftoff_angle)
 

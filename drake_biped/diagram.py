@@ -14,7 +14,7 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, Vector
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_biped.controller import CpgWalkingController
-from drake_biped.kinematics import LinkMasses, leg_points
+from drake_biped.kinematics import TABLE_I_BODY, LinkMasses, leg_points, masses_of
 from drake_biped.model import add_biped
 from drake_biped.params import EpisodeConfig, Push
 
@@ -49,20 +49,26 @@ class BipedDiagram:
     diagram: Diagram
     plant: MultibodyPlant
     controller: CpgWalkingController
-    masses: LinkMasses  # the model's, as the plant holds them
+    body: np.ndarray  # kinematics.BODY, the model's as the plant holds it (`model.body_of`)
     state_log: VectorLogSink | None = None
     controller_log: VectorLogSink | None = None
     actuation_log: VectorLogSink | None = None
 
+    @property
+    def masses(self) -> LinkMasses:
+        """The model's link masses."""
+        return masses_of(self.body)
 
-def initial_state(config: EpisodeConfig) -> tuple[np.ndarray, np.ndarray, bool, float]:
+
+def initial_state(config: EpisodeConfig, body: np.ndarray = TABLE_I_BODY) -> tuple[np.ndarray, np.ndarray, bool, float]:
     """The paper's initiation: q, v, whether the right leg is the first stance leg, the swing lift-off angle.
 
     The initial hip angle is the angle between the thighs (the inter-leg angle of the Poincare section):
     the torso at its reference lean (GaitParams.torso_pitch_rad, so the torso servo starts at rest), the
     right thigh at +hip_angle/2 from vertical (front, stance), the left at -hip_angle/2 (rear, swing), knees
     straight, feet parallel to the ground, lowest contact point 0.1 mm above it; every body moves forward
-    at the initial speed (a horizontal velocity of the floating base with zero joint rates)."""
+    at the initial speed (a horizontal velocity of the floating base with zero joint rates). `body`: the
+    model's (kinematics.BODY), for the height that puts the lowest foot point on the ground."""
     a = 0.5 * config.initial.hip_angle_rad
     slope0 = config.ground.slope_at(0.0)
     pitch = config.gait.torso_pitch_rad
@@ -72,7 +78,7 @@ def initial_state(config: EpisodeConfig) -> tuple[np.ndarray, np.ndarray, bool, 
     q[5], q[8] = slope0 + a, slope0 - a  # foot angle = thigh - knee + ankle = local slope
     lowest = math.inf
     for i in (3, 6):
-        p = leg_points(0.0, 0.0, pitch, q[i], q[i + 1], q[i + 2])
+        p = leg_points(0.0, 0.0, pitch, q[i], q[i + 1], q[i + 2], body)
         for px, pz in ((p.heel_x, p.heel_z), (p.toe_x, p.toe_z)):
             lowest = min(lowest, pz - config.ground.height(px))
     q[1] = -lowest + 1e-4
@@ -91,13 +97,12 @@ def build_diagram(
     summary needs (the controller's own state: work integrals, touchdowns, fall flag).
     """
     builder = DiagramBuilder()
-    handles = add_biped(
-        builder, config.ground, config.sim.time_step_s, contact_approximation=config.sim.contact_approximation
-    )
+    handles = add_biped(builder, config.ground, config.sim.time_step_s, config.model,
+                        contact_approximation=config.sim.contact_approximation)
     plant = handles.plant
-    _, _, stance_right, liftoff = initial_state(config)
+    _, _, stance_right, liftoff = initial_state(config, handles.body)
     controller = builder.AddNamedSystem("cpg_controller",
-                                        CpgWalkingController(config, stance_right, liftoff, handles.masses))
+                                        CpgWalkingController(config, stance_right, liftoff, handles.body))
     builder.Connect(plant.get_state_output_port(), controller.get_input_port_plant_state())
     builder.Connect(controller.get_output_port_actuation(), plant.get_actuation_input_port())
     if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:
@@ -121,7 +126,7 @@ def build_diagram(
         )
     diagram = builder.Build()
     diagram.set_name("drake_biped")
-    return BipedDiagram(diagram, plant, controller, handles.masses, **logs)
+    return BipedDiagram(diagram, plant, controller, handles.body, **logs)
 
 
 def build_replay_diagram(
@@ -140,9 +145,8 @@ def build_replay_diagram(
     if times.ndim != 1 or torques.shape != (times.size, 6) or times.size < 1:
         raise ValueError(f"expected times (n,) and torques (n, 6), got {times.shape} and {torques.shape}")
     builder = DiagramBuilder()
-    plant = add_biped(
-        builder, config.ground, config.sim.time_step_s, contact_approximation=config.sim.contact_approximation
-    ).plant
+    plant = add_biped(builder, config.ground, config.sim.time_step_s, config.model,
+                      contact_approximation=config.sim.contact_approximation).plant
     breaks = np.append(times, times[-1] + config.sim.control_period_s)
     hold = PiecewisePolynomial.ZeroOrderHold(breaks, np.vstack([torques, torques[-1:]]).T)
     source = builder.AddNamedSystem("logged_torques", TrajectorySource(hold))

@@ -120,7 +120,7 @@ class DiagramCache:
     episodes of a learning run or a grid search; rebuilding the diagram for each would cost a few ms and,
     with pydrake 1.51, leak ~0.4 MB per build (RobotLocomotion/drake#24529). An entry is keyed by what the
     diagram is built from: the ground, time step, control period, time limit, minimum step time, contact
-    approximation, push and recording. At most `size` entries are kept (least recently used goes first).
+    approximation, push, robot model and recording. At most `size` entries are kept (least recently used goes first).
     """
 
     def __init__(self, size: int = 4):
@@ -133,6 +133,7 @@ class DiagramCache:
             CpgWalkingController.structure_key(config),
             config.sim.contact_approximation,
             config.push,
+            None if config.model is None else config.model.sha256,
             record,
             log_period_s,
         )
@@ -186,10 +187,10 @@ def reset_context(parts: BipedDiagram, simulator: Simulator, config: EpisodeConf
             log.FindMutableLog(root).Clear()
     parts.controller.configure(config)
     plant_ctx = parts.plant.GetMyMutableContextFromRoot(root)
-    q0, v0, stance_right, liftoff = initial_state(config)
+    q0, v0, stance_right, liftoff = initial_state(config, parts.body)
     parts.plant.SetPositions(plant_ctx, q0)
     parts.plant.SetVelocities(plant_ctx, v0)
-    com_x0 = center_of_mass(q0, parts.masses)[0]
+    com_x0 = center_of_mass(q0, parts.body)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
     parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
                                       pitch=q0[2], phase=config.initial.cpg_phase_rad)
@@ -289,8 +290,8 @@ def run_episode(
     else:
         fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
 
-    q0, _, _, _ = initial_state(config)
-    distance = s.com_x_m - center_of_mass(q0, parts.masses)[0]
+    q0, _, _, _ = initial_state(config, parts.body)
+    distance = s.com_x_m - center_of_mass(q0, parts.body)[0]
 
     work = s.positive_work_j
     positive = {n: float(work[i]) for i, n in enumerate(JOINT_NAMES)}
@@ -365,6 +366,7 @@ def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
         "cpg_phase": rows(ctrl, "cpg_phase"),
         "torque_free": rows(ctrl, "torque_free"),
         "stance_right": rows(ctrl, "stance_right"),
+        "contact_right": rows(ctrl, "contact_right"),
         "step_start": rows(ctrl, "step_start_s"),
         "positive_work": rows(ctrl, "positive_work_j"),
         "position_names": np.array(["x", "z", "pitch", *JOINT_NAMES]),

@@ -1,8 +1,14 @@
-"""Build the biped MultibodyPlant from the model file and add the ground.
+"""Build the biped MultibodyPlant from a model file and add the ground; read the controller's body from it.
 
-The robot is loaded by `package://drake_biped/biped.urdf` through the `package.xml` shipped as package data
-(`drake_biped.models`, the repository's models/ folder), never by a path relative to the caller's working
-directory or the source tree.
+The shipped robot is loaded by `package://drake_biped/biped.urdf` through the `package.xml` shipped as package
+data (`drake_biped.models`, the repository's models/ folder), never by a path relative to the caller's working
+directory or the source tree. A user's model (`params.RobotModel`, `--model FILE`) is parsed from its text;
+its package:// URIs resolve through the package.xml beside it, when there is one, and the shipped package.
+
+`body_of` reads the controller's planar kinematics (joint positions, centres of mass, contact spheres, masses)
+from the finalized plant. What cannot be read, it checks, with one line naming what is missing or different:
+the links' and joints' names, a planar base, mirror-image legs, joints that turn in the sagittal plane with
+the shipped model's signs, and a heel and a toe sphere on each foot.
 """
 
 from __future__ import annotations
@@ -24,8 +30,15 @@ from pydrake.multibody.plant import (
 )
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_biped.kinematics import FOOT_COM_M, SHANK_M, THIGH_M, TORSO_M, LinkMasses, link_masses
-from drake_biped.params import CONTACT_RADIUS_M, GRAVITY_MPS2, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M, Ground
+from drake_biped.kinematics import (
+    LinkMasses,
+    body_vector,
+    center_of_mass_k,
+    leg_points_k,
+    link_masses,
+    masses_of,
+)
+from drake_biped.params import GRAVITY_MPS2, Ground, RobotModel
 from drake_biped.resources import model_package_xml
 
 MODEL_URL = "package://drake_biped/biped.urdf"
@@ -67,18 +80,23 @@ class ModelError(RuntimeError):
 class PlantHandles:
     plant: MultibodyPlant
     scene_graph: SceneGraph
-    masses: LinkMasses  # read from the model file: every per-kg figure and the centre of mass use these
+    body: np.ndarray  # kinematics.BODY, read from the model (`body_of`): the controller and the centre of mass
+
+    @property
+    def masses(self) -> LinkMasses:
+        """The model's link masses: every per-kg figure uses these."""
+        return masses_of(self.body)
 
 
 def add_biped(
     builder: DiagramBuilder,
     ground: Ground,
     time_step_s: float,
-    model_url: str = MODEL_URL,
-    package_xml: Path | None = None,
+    model: RobotModel | None = None,
     contact_approximation: str = "sap",
 ) -> PlantHandles:
-    """Add the biped and the ground to `builder` and finalize the plant.
+    """Add the biped (`model`, or the shipped one) and the ground to `builder`, finalize the plant and read
+    the controller's body from it.
 
     Contact: point contact (the heel/toe spheres against the ground half-space(s)), solved by the discrete
     contact approximation given (SAP by default). Output ports are sampled (see controller "Timing").
@@ -91,20 +109,37 @@ def add_biped(
         penetration_allowance=1e-3,
     )
     plant, scene_graph = AddMultibodyPlant(config, builder)
-    parser = Parser(plant)
-    package_xml = model_package_xml() if package_xml is None else Path(package_xml)
-    if not package_xml.is_file():
-        raise ModelError(f"model package file not found: {package_xml}")
-    parser.package_map().AddPackageXml(str(package_xml))
-    try:
-        parser.AddModels(url=model_url)
-    except Exception as exc:  # Drake raises RuntimeError with the parser's message
-        raise ModelError(f"could not parse the biped model {model_url}: {exc}") from exc
+    parse_model(Parser(plant), model)
     _add_ground(plant, ground)
     plant.Finalize()
     check_layout(plant)
-    check_geometry(plant, scene_graph)
-    return PlantHandles(plant, scene_graph, link_masses_of(plant))
+    return PlantHandles(plant, scene_graph, body_of(plant, scene_graph))
+
+
+def parse_model(parser: Parser, model: RobotModel | None = None) -> None:
+    """Add `model` (or the shipped robot) to the parser's plant; ModelError naming the file when it cannot be
+    parsed."""
+    packages = parser.package_map()
+    if model is not None and model.package_xml is not None and Path(model.package_xml).is_file():
+        packages.AddPackageXml(model.package_xml)
+    if not packages.Contains("drake_biped"):
+        shipped = model_package_xml()
+        if not shipped.is_file():
+            raise ModelError(f"model package file not found: {shipped}")
+        packages.AddPackageXml(str(shipped))
+    name = MODEL_URL if model is None else model.name
+    if model is not None:
+        _check_masses(model)
+    try:
+        if model is None:
+            parser.AddModels(url=MODEL_URL)
+        else:
+            parser.AddModelsFromString(model.text, model.format)
+    except Exception as exc:  # Drake raises RuntimeError with the parser's message
+        detail = " ".join(str(exc).split())
+        if model is not None:  # Drake names a text it parsed "<literal-string>.urdf": name the file
+            detail = detail.replace(f"<literal-string>.{model.format}", model.name)
+        raise ModelError(f"could not parse the model {name}: {detail}") from exc
 
 
 # A level-then-slope ground's boxes: the level part from GROUND_BEHIND_M (behind the start) to the slope's foot,
@@ -175,18 +210,19 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
 
 
 def check_layout(plant: MultibodyPlant) -> None:
-    """Raise ModelError unless positions, velocities and actuators follow JOINT_NAMES' order."""
-    if plant.num_positions() != 9 or plant.num_velocities() != 9 or plant.num_actuators() != 6:
-        raise ModelError(
-            f"expected 9 positions, 9 velocities and 6 actuators, got {plant.num_positions()}, "
-            f"{plant.num_velocities()}, {plant.num_actuators()}"
-        )
+    """Raise ModelError unless the joints and actuators are named as the shipped model's and positions,
+    velocities and actuators follow JOINT_NAMES' order."""
     for name in ("floating_base", *JOINT_NAMES):
         if not plant.HasJointNamed(name):
             raise ModelError(f"the model has no joint named {name!r}; expected {['floating_base', *JOINT_NAMES]}")
     for name in JOINT_NAMES:
         if not plant.HasJointActuatorNamed(f"{name}_motor"):
             raise ModelError(f"the model has no actuator named {name + '_motor'!r} (a <transmission> for joint {name})")
+    if plant.num_positions() != 9 or plant.num_velocities() != 9 or plant.num_actuators() != 6:
+        raise ModelError(
+            f"expected 9 positions, 9 velocities and 6 actuators, got {plant.num_positions()}, "
+            f"{plant.num_velocities()}, {plant.num_actuators()}"
+        )
     base = plant.GetJointByName("floating_base")
     if base.type_name() != "planar" or base.position_start() != 0:
         raise ModelError("the floating base must be the planar joint at position 0")
@@ -199,9 +235,43 @@ def check_layout(plant: MultibodyPlant) -> None:
             raise ModelError(f"actuator {name}_motor has index {int(actuator.index())}, expected {i}")
 
 
+def _check_masses(model: RobotModel) -> None:
+    """ModelError naming the link when the model file gives a link a mass that is not positive (Drake's parser
+    only warns, and gives the link a default mass)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.fromstring(model.text)
+    except ET.ParseError as exc:
+        raise ModelError(f"could not parse the model {model.name}: {exc}") from None
+    for link in root.iter("link"):
+        mass = link.find("inertial/mass")
+        if mass is None:
+            continue
+        text = mass.get("value") if model.format == "urdf" else mass.text
+        try:
+            value = float(text)
+        except (TypeError, ValueError):
+            raise ModelError(f"the model {model.name}: link {link.get('name')} has mass {text!r}, not a number") \
+                from None
+        if not value > 0.0:
+            raise ModelError(f"the model {model.name}: link {link.get('name')} has mass {value!r} kg; every "
+                             "link's mass must be positive")
+
+
+LINKS = ("torso", *(f"{leg}_{link}" for leg in LEGS for link in ("thigh", "shank", "foot")))
+
+
 def link_masses_of(plant: MultibodyPlant) -> LinkMasses:
-    """The links' masses as the model file gives them; ModelError unless the legs are mirror images (the
-    controller's centre of mass takes one mass per link kind)."""
+    """The links' masses as the model file gives them; ModelError unless each is positive and the legs are
+    mirror images (the controller's centre of mass takes one mass per link kind)."""
+    for name in LINKS:
+        if not plant.HasBodyNamed(name):
+            raise ModelError(f"the model has no link named {name!r}; expected {list(LINKS)}")
+        m = float(plant.GetBodyByName(name).default_mass())
+        if not m > 0.0:
+            raise ModelError(f"link {name} has mass {m!r} kg; every link's mass must be positive")
+
     def mass(name: str) -> float:
         return float(plant.GetBodyByName(name).default_mass())
 
@@ -212,45 +282,103 @@ def link_masses_of(plant: MultibodyPlant) -> LinkMasses:
     return link_masses(mass("torso"), *legs["left"])
 
 
-def check_geometry(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: float = 1e-9) -> None:
-    """Raise ModelError, naming the quantity and both values, unless the model's lengths, centres of mass and
-    foot contact spheres are those the controller's planar kinematics uses (`kinematics`): the controller
-    computes touchdowns, falls and the centre of mass from them."""
-    def check(what: str, model_value, expected) -> None:
-        model_value, expected = np.asarray(model_value, float), np.asarray(expected, float)
-        if model_value.shape != expected.shape or np.max(np.abs(model_value - expected)) > tolerance_m:
-            raise ModelError(f"the model's {what} is {np.round(model_value, 6).tolist()}, but the controller's "
-                             f"kinematics uses {np.round(expected, 6).tolist()} (drake_biped/kinematics.py)")
+# The joints' axes in the shipped model (the kinematics' sign conventions follow from them).
+JOINT_AXES = {"hip": (0.0, -1.0, 0.0), "knee": (0.0, 1.0, 0.0), "ankle": (0.0, -1.0, 0.0)}
 
-    def xz(v) -> list[float]:
-        return [float(v[0]), float(v[2])]
 
-    check("gravity (x, y, z, m/s^2; C_mt divides by m g d with g = params.GRAVITY_MPS2)",
-          plant.gravity_field().gravity_vector(), [0.0, 0.0, -GRAVITY_MPS2])
-    check("torso centre of mass (x, z in the torso frame, m)", xz(plant.GetBodyByName("torso").default_com()),
-          [0.0, 0.5 * TORSO_M])
+def _xz(v) -> tuple[float, float]:
+    return float(v[0]), float(v[2])
+
+
+def _leg_geometry(plant: MultibodyPlant, scene_graph: SceneGraph, leg: str) -> dict[str, tuple]:
+    """One leg's joint positions, centres of mass and foot spheres (x, z in the parent link's frame, m)."""
+    out: dict[str, tuple] = {}
+    for joint in JOINTS_OF_A_LEG:
+        j = plant.GetJointByName(f"{leg}_{joint}")
+        if j.type_name() != "revolute":
+            raise ModelError(f"joint {leg}_{joint} is a {j.type_name()} joint; expected a revolute joint")
+        axis = tuple(float(a) for a in j.revolute_axis())
+        if max(abs(a - b) for a, b in zip(axis, JOINT_AXES[joint])) > 1e-9:
+            raise ModelError(f"joint {leg}_{joint} turns about {list(axis)}; the toolkit expects "
+                             f"{list(JOINT_AXES[joint])} (models/biped.urdf's sign conventions)")
+        for side, frame in (("parent", j.frame_on_parent()), ("child", j.frame_on_child())):
+            pose = frame.GetFixedPoseInBodyFrame()
+            if not pose.rotation().IsNearlyIdentity(1e-12):
+                raise ModelError(f"joint {leg}_{joint}'s frame on its {side} link is rotated; the toolkit expects "
+                                 "unrotated joint frames (a link's angle is its joint angles' sum)")
+            if side == "child" and np.max(np.abs(pose.translation())) > 1e-12:
+                raise ModelError(f"joint {leg}_{joint} is not at its child link's origin "
+                                 f"({pose.translation().tolist()}); put the link's frame at the joint")
+        out[joint] = _xz(j.frame_on_parent().GetFixedPoseInBodyFrame().translation())
+    for link in ("thigh", "shank", "foot"):
+        out[f"{link}_com"] = _xz(plant.GetBodyByName(f"{leg}_{link}").default_com())
+    inspector = scene_graph.model_inspector()
+    spheres = []
+    for geometry in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(f"{leg}_foot")):
+        shape = inspector.GetShape(geometry)
+        if not isinstance(shape, Sphere):
+            raise ModelError(f"{leg}_foot collides through a {type(shape).__name__}; the controller's "
+                             "kinematics expects a sphere at the heel and one at the toe")
+        x, z = _xz(inspector.GetPoseInFrame(geometry).translation())
+        radius = float(shape.radius())
+        spheres.append((x, z - radius, radius))  # the sphere's lowest point with the foot flat: the sole
+    if len(spheres) != 2:
+        raise ModelError(f"{leg}_foot has {len(spheres)} collision spheres; expected two (a heel and a toe)")
+    out["heel"], out["toe"] = sorted(spheres)
+    return out
+
+
+_GEOMETRY_NAMES = {"hip": "hip position in the torso frame (x, z)", "knee": "knee position in the thigh frame",
+                   "ankle": "ankle position in the shank frame", "thigh_com": "thigh centre of mass",
+                   "shank_com": "shank centre of mass", "foot_com": "foot centre of mass",
+                   "heel": "heel sphere (x, sole z, radius)", "toe": "toe sphere (x, sole z, radius)"}
+
+
+def body_of(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: float = 1e-9) -> np.ndarray:
+    """The controller's body (kinematics.BODY) read from a finalized plant: joint positions, centres of mass
+    and foot contact spheres in their links' frames (x, z: the sagittal plane), and the masses. ModelError,
+    naming what and both values, when the legs differ, the gravity is not params.GRAVITY_MPS2 (C_mt divides by
+    m g d with it), or the planar kinematics does not reproduce the plant (checked at one configuration)."""
+    gravity = plant.gravity_field().gravity_vector()
+    if np.max(np.abs(gravity - [0.0, 0.0, -GRAVITY_MPS2])) > tolerance_m:
+        raise ModelError(f"the model's gravity is {gravity.tolist()} m/s^2; the toolkit uses "
+                         f"[0, 0, -{GRAVITY_MPS2}] (C_mt divides by m g d with it)")
+    masses = link_masses_of(plant)
+    legs = {leg: _leg_geometry(plant, scene_graph, leg) for leg in LEGS}
+    for key, what in _GEOMETRY_NAMES.items():
+        left, right = legs["left"][key], legs["right"][key]
+        if max(abs(a - b) for a, b in zip(left, right)) > tolerance_m:
+            raise ModelError(f"the legs differ: the left {what} is {np.round(left, 6).tolist()} m, the right "
+                             f"{np.round(right, 6).tolist()} m; the toolkit assumes mirror-image legs")
+    g = legs["left"]
+    body = body_vector(masses, hip=g["hip"], torso_com=_xz(plant.GetBodyByName("torso").default_com()),
+                       knee=g["knee"], thigh_com=g["thigh_com"], ankle=g["ankle"], shank_com=g["shank_com"],
+                       foot_com=g["foot_com"], heel=g["heel"], toe=g["toe"])
+    _check_body(plant, body, tolerance_m)
+    return body
+
+
+def _check_body(plant: MultibodyPlant, body: np.ndarray, tolerance_m: float) -> None:
+    """ModelError unless the planar kinematics of `body` puts the knees, ankles and the centre of mass where the
+    plant does, at one configuration away from every symmetry."""
+    q = np.array([0.3, 0.9, 0.1, 0.4, 0.7, -0.2, -0.3, 0.2, 0.25])
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q)
+    points = {leg: leg_points_k(body, q[0], q[1], q[2], *q[3 + 3 * i: 6 + 3 * i]) for i, leg in enumerate(LEGS)}
     for leg in LEGS:
-        offset = plant.GetJointByName(f"{leg}_hip").frame_on_parent().GetFixedPoseInBodyFrame().translation()
-        check(f"{leg} hip position in the torso frame (x, z, m)", xz(offset), [0.0, 0.0])
-        for joint, parent, length in (("knee", "thigh", THIGH_M), ("ankle", "shank", SHANK_M)):
-            frame = plant.GetJointByName(f"{leg}_{joint}").frame_on_parent()
-            check(f"{leg} {joint} position in the {parent} frame (x, z, m; the {parent} length)",
-                  xz(frame.GetFixedPoseInBodyFrame().translation()), [0.0, -length])
-            check(f"{leg} {parent} centre of mass (x, z, m)", xz(plant.GetBodyByName(f"{leg}_{parent}").default_com()),
-                  [0.0, -0.5 * length])
-        foot = plant.GetBodyByName(f"{leg}_foot")
-        check(f"{leg} foot centre of mass (x, z in the ankle frame, m)", xz(foot.default_com()), list(FOOT_COM_M))
-        inspector = scene_graph.model_inspector()
-        spheres = []
-        for geometry in plant.GetCollisionGeometriesForBody(foot):
-            shape = inspector.GetShape(geometry)
-            if not isinstance(shape, Sphere):
-                raise ModelError(f"{leg}_foot collides through a {type(shape).__name__}; the controller's "
-                                 "kinematics expects a sphere at the heel and one at the toe")
-            spheres.append([*xz(inspector.GetPoseInFrame(geometry).translation()), shape.radius()])
-        check(f"{leg} foot contact spheres (x, z, radius in the ankle frame, m)", sorted(spheres),
-              [[HEEL_X_M, CONTACT_RADIUS_M - SOLE_DEPTH_M, CONTACT_RADIUS_M],
-               [TOE_X_M, CONTACT_RADIUS_M - SOLE_DEPTH_M, CONTACT_RADIUS_M]])
+        for joint, slot in (("knee", 0), ("ankle", 2)):
+            frame = plant.GetJointByName(f"{leg}_{joint}").frame_on_child()
+            got = _xz(frame.CalcPoseInWorld(context).translation())
+            want = points[leg][slot], points[leg][slot + 1]
+            if max(abs(a - b) for a, b in zip(got, want)) > tolerance_m:
+                raise ModelError(f"the model's {leg} {joint} is at {np.round(got, 6).tolist()} m where the planar "
+                                 f"kinematics puts it at {np.round(want, 6).tolist()} m: the base must be planar "
+                                 "in x-z with the torso's pitch about -y, as in models/biped.urdf")
+    com = _xz(plant.CalcCenterOfMassPositionInWorld(context))
+    want = center_of_mass_k(body, q[0], q[1], q[2], points["left"], points["right"])
+    if max(abs(a - b) for a, b in zip(com, want)) > tolerance_m:
+        raise ModelError(f"the model's centre of mass is at {np.round(com, 6).tolist()} m where the planar "
+                         f"kinematics puts it at {np.round(want, 6).tolist()} m")
 
 
 def effort_limits(plant: MultibodyPlant) -> np.ndarray:
@@ -258,7 +386,23 @@ def effort_limits(plant: MultibodyPlant) -> np.ndarray:
     return np.array([plant.GetJointActuatorByName(f"{n}_motor").effort_limit() for n in JOINT_NAMES])
 
 
-def build_plant(ground: Ground | None = None, time_step_s: float = 1e-3) -> MultibodyPlant:
+def build_plant(ground: Ground | None = None, time_step_s: float = 1e-3,
+                model: RobotModel | None = None) -> MultibodyPlant:
     """A finalized plant in its own diagram builder, for inspection and tests."""
     builder = DiagramBuilder()
-    return add_biped(builder, ground or Ground(), time_step_s).plant
+    return add_biped(builder, ground or Ground(), time_step_s, model).plant
+
+
+_BODIES: dict[str | None, np.ndarray] = {}
+
+
+def body_of_model(model: RobotModel | None = None) -> np.ndarray:
+    """The body (kinematics.BODY) of `model` (None: the shipped robot), read from its plant once per model
+    and kept; ModelError as `add_biped`. A read-only array."""
+    key = None if model is None else model.sha256
+    if key not in _BODIES:
+        handles = add_biped(DiagramBuilder(), Ground(), 1e-3, model)
+        body = handles.body
+        body.flags.writeable = False
+        _BODIES[key] = body
+    return _BODIES[key]

@@ -7,9 +7,11 @@ SI units throughout; angles in radians (degrees appear only at the command-line 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any
 
 from drake_biped.paper import (
@@ -22,7 +24,7 @@ from drake_biped.paper import (
 __all__ = [
     "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
-    "CYCLE_INITIAL",
+    "CYCLE_INITIAL", "RobotModel",
 ]
 
 TOTAL_MASS_KG = TABLE_I_TOTAL_MASS_KG
@@ -181,10 +183,23 @@ class GaitParams(_Validated):
     - "integrated": the reference angle is phi_0 + the integral of zeta since T_n, as printed; placement
       feedback (and swing_offset_rad) only add an offset blended in by (1 - cos gamma) / 2. Both readings
       servo the rate to zeta itself.
+
+    `phase_reading` says what a touchdown does to the CPG:
+    - "reset": gamma is set to 0 at each confirmed touchdown and the legs swap roles there (phase resetting,
+      one CPG half-cycle per step);
+    - "entrained": gamma runs free (Section II-C's "the stance and the swing leg are changed by zeta", a CPG
+      adapted from Cohen's models): the sign of zeta - u_eta = alpha u_a sin(gamma) chooses which hip swings,
+      so the hips swap roles where gamma crosses a multiple of pi, and only the ankle term kappa * (stance
+      ankle rate) locks the oscillator to the body (Taga-style entrainment). A touchdown (the foot that did
+      not land last crossing the touchdown height) only marks T_n, which the torque-free window and the
+      Poincare section count from; touchdown_min_phase is not used.
+    Either swing reading applies within each half-cycle.
     """
 
     # How zeta drives the swing (above): "anchored" or "integrated".
     swing_reading: str = "anchored"
+    # What a touchdown does to the CPG (above): "reset" or "entrained".
+    phase_reading: str = "reset"
     # When the roles' torques swap at a touchdown: "predicted", at the instant inside the control period
     # where the swing foot's clearance, extrapolated over the period, crosses the touchdown height (the
     # period's torques blend the two roles' by the part of it each holds); "update", from the update that
@@ -260,12 +275,16 @@ class GaitParams(_Validated):
 
     SWING_READINGS = ("anchored", "integrated")
     SWAP_TIMINGS = ("predicted", "update")
+    PHASE_READINGS = ("reset", "entrained")
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.swing_reading not in self.SWING_READINGS:
             raise ParameterError(f"GaitParams.swing_reading = {self.swing_reading!r} is not one of "
                                  f"{list(self.SWING_READINGS)}")
+        if self.phase_reading not in self.PHASE_READINGS:
+            raise ParameterError(f"GaitParams.phase_reading = {self.phase_reading!r} is not one of "
+                                 f"{list(self.PHASE_READINGS)}")
         if self.swap_timing not in self.SWAP_TIMINGS:
             raise ParameterError(f"GaitParams.swap_timing = {self.swap_timing!r} is not one of "
                                  f"{list(self.SWAP_TIMINGS)}")
@@ -403,6 +422,68 @@ class SimulationParams(_Validated):
             )
 
 
+MODEL_FORMATS = {".urdf": "urdf", ".sdf": "sdf"}
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    """A robot model file given by the user (URDF or SDFormat), carried by its content: an episode on a Dask
+    worker on another machine parses the same text, and a record names the file and its SHA-256.
+
+    `package_xml`: the package.xml beside the file when there was one (its packages resolve the file's
+    package:// URIs on the machine where it is found; the shipped `drake_biped` package always resolves).
+    As a record (`to_dict`) it is {"name", "sha256", "format", "package_xml", "text"}; `from_dict` checks the
+    text against the SHA-256."""
+
+    name: str
+    text: str
+    format: str = "urdf"
+    sha256: str = ""
+    package_xml: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.format not in MODEL_FORMATS.values():
+            raise ParameterError(f"model {self.name!r}: format {self.format!r} is not one of "
+                                 f"{sorted(MODEL_FORMATS.values())}")
+        digest = hashlib.sha256(self.text.encode()).hexdigest()
+        if self.sha256 and self.sha256 != digest:
+            raise ParameterError(f"model {self.name!r}: its text's SHA-256 is {digest}, not the recorded "
+                                 f"{self.sha256}")
+        object.__setattr__(self, "sha256", digest)
+
+    @classmethod
+    def from_file(cls, path: str | Path, option: str = "--model") -> RobotModel:
+        """The model in `path`; ParameterError naming `option` and the path when it is missing, unreadable or
+        of another kind than .urdf or .sdf."""
+        path = Path(path)
+        kind = MODEL_FORMATS.get(path.suffix.lower())
+        if kind is None:
+            raise ParameterError(f"{option} {str(path)!r}: not a .urdf or .sdf file")
+        if not path.is_file():
+            raise ParameterError(f"{option} {str(path)!r}: no such file")
+        try:
+            text = path.read_text()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ParameterError(f"{option} {str(path)!r}: cannot be read ({exc})") from None
+        beside = path.resolve().parent / "package.xml"
+        return cls(path.name, text, kind, package_xml=str(beside) if beside.is_file() else None)
+
+    @classmethod
+    def from_dict(cls, data: Any, where: str = "model") -> RobotModel:
+        if not isinstance(data, Mapping) or not isinstance(data.get("text"), str) or \
+                not isinstance(data.get("name"), str):
+            raise ParameterError(f"{where}: expected a model file's path or a record with its name and text, "
+                                 f"got {type(data).__name__}")
+        unknown = sorted(set(data) - {f.name for f in fields(cls)})
+        if unknown:
+            raise ParameterError(f"{where}: unknown field(s) {unknown}")
+        return cls(**data)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "sha256": self.sha256, "format": self.format, "package_xml": self.package_xml,
+                "text": self.text}
+
+
 @dataclass(frozen=True)
 class EpisodeConfig(_Validated):
     """Everything one episode depends on."""
@@ -415,8 +496,17 @@ class EpisodeConfig(_Validated):
     push: Push | None = None
     sim: SimulationParams = field(default_factory=SimulationParams)
     seed: int = 0
+    # The robot: None for the shipped model (models/biped.urdf, Table I), else a user's model file.
+    model: RobotModel | None = None
 
     def __post_init__(self) -> None:
+        if isinstance(self.model, (str, Path)):
+            object.__setattr__(self, "model", RobotModel.from_file(self.model, "EpisodeConfig.model"))
+        elif isinstance(self.model, Mapping):
+            object.__setattr__(self, "model", RobotModel.from_dict(self.model, "EpisodeConfig.model"))
+        elif self.model is not None and not isinstance(self.model, RobotModel):
+            raise ParameterError(f"EpisodeConfig.model must be a model file's path or a RobotModel, got "
+                                 f"{type(self.model).__name__}")
         super().__post_init__()
         if self.seed < 0:
             raise ParameterError(f"EpisodeConfig.seed must be a non-negative integer, got {self.seed!r}")

@@ -14,7 +14,8 @@ from pathlib import Path
 
 from drake_biped.params import EpisodeConfig, ParameterError
 
-__all__ = ["full_run_digest", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml"]
+__all__ = ["full_run_digest", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
+           "shipped_model_file"]
 
 
 def _package_path(package: str, *parts: str) -> Path:
@@ -26,6 +27,11 @@ def _package_path(package: str, *parts: str) -> Path:
 def model_package_xml() -> Path:
     """The `package.xml` of the `drake_biped` model package (biped.urdf beside it)."""
     return _package_path("drake_biped.models", "package.xml")
+
+
+def shipped_model_file() -> Path:
+    """The shipped robot's URDF (Table I): the file to copy and edit for a robot of one's own (`--model`)."""
+    return _package_path("drake_biped.models", "biped.urdf")
 
 
 def full_run_digest() -> dict:
@@ -71,11 +77,15 @@ def grid_spec_path(value: str | Path) -> Path:
 
 def load_gait(value: str | Path) -> EpisodeConfig:
     """The EpisodeConfig of a shipped gait (by name) or of a parameter file: EpisodeConfig fields as JSON,
-    or a result record (a walk's result.json, a grid's best_params.json), whose "config" is used."""
+    or a result record (a walk's result.json, a grid's best_params.json), whose "config" is used. Its "model"
+    is a model file's path (relative to the parameter file) or a record of one (its name, SHA-256 and text)."""
     from drake_biped.records import read_json
 
     path = gait_path(value)
     data = read_json(path, "--params")
     if isinstance(data, dict) and "config" in data:
         data = data["config"]
+    if isinstance(data, dict) and isinstance(data.get("model"), str):
+        # a model file named in a parameter file: a relative path is relative to the parameter file
+        data = {**data, "model": str(Path(path).parent / data["model"])}
     return EpisodeConfig.from_dict(data, f"--params {path}")

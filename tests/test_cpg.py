@@ -173,3 +173,30 @@ def test_integrated_reading_drives_the_swing_by_zeta_unscaled():
     assert read > 150
     assert travel == pytest.approx(PAPER_CPG.u_a * (1 - math.cos(min(math.pi, 399 * dt * PAPER_CPG.u_r)))
                                    / PAPER_CPG.u_r, abs=0.01)
+
+
+@pytest.mark.parametrize("gait, reading", [(None, "reset"), ("paper_entrained", "entrained")])
+def test_the_phase_reading_decides_what_swaps_the_legs(gait, reading):
+    """Under "reset" the legs swap roles at each touchdown and the phase starts again from 0 there; under
+    "entrained" the phase runs on through touchdowns and the roles swap where it crosses pi (where zeta's
+    sign changes), each touchdown only moving the step's clock and the leg in contact."""
+    from drake_biped.episode import run_episode
+    from drake_biped.resources import load_gait
+
+    config = (EpisodeConfig() if gait is None else load_gait(gait)).override({"sim.distance_m": 3.0})
+    assert config.gait.phase_reading == reading
+    r = run_episode(config, record_trajectory=True, cache=None)
+    T = r.trajectory
+    gamma, roles, contact, clock = T["cpg_phase"], T["stance_right"], T["contact_right"], T["step_start"]
+    role_swaps = set(np.flatnonzero(np.diff(roles) != 0) + 1)
+    touchdowns = set(np.flatnonzero(np.diff(clock) != 0) + 1)
+    wraps = set(np.flatnonzero(np.diff(gamma) < -1.0) + 1)  # the phase falling back by more than 1 rad
+    assert len(touchdowns) >= 3 and len(role_swaps) >= 3
+    assert touchdowns == set(np.flatnonzero(np.diff(contact) != 0) + 1)  # a touchdown changes the contact leg
+    if reading == "reset":
+        assert role_swaps == touchdowns == wraps
+        assert np.array_equal(roles, contact)
+    else:
+        assert role_swaps == wraps  # the phase, not the feet, swaps the roles
+        assert touchdowns - role_swaps  # and most touchdowns fall elsewhere in the half-cycle
+        assert gamma.max() < math.pi and gamma.min() >= 0.0

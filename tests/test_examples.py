@@ -103,3 +103,15 @@ def test_a_failed_run_of_an_example_is_one_line_with_exit_code_1(tmp_path):
     assert out.returncode == 1 and len(lines) == 1 and "Traceback" not in out.stderr, out.stderr
     assert lines[0] == ("return_map.py: failed: ValueError: fit_return_map needs at least 3 pairs for a 2-D map, "
                         "got 0 (set DRAKE_BIPED_DEBUG=1 for the traceback)")
+
+
+def test_own_robot(tmp_path):
+    text = run(tmp_path, "own_robot.py", "--distance", "1.5", "--out", "robot")
+    rows = {line.split()[0]: line[36:].split() for line in text.splitlines() if line.startswith(("shipped", "own"))}
+    assert list(rows) == ["shipped", "own:"]
+    # the model's mass: the torso 20 % heavier, the shanks as heavy as before
+    assert float(rows["shipped"][0]) == 10.202
+    assert float(rows["own:"][0]) == pytest.approx(10.202 + 0.2 * 6.646, abs=1e-3)
+    assert all(row[5] in ("walked", "fell") for row in rows.values())
+    urdf = (tmp_path / "robot" / "own_robot.urdf").read_text()
+    assert '<origin xyz="0 0 -0.3487" />' in urdf  # the ankle 10 % further down the shank

@@ -121,16 +121,21 @@ def test_bad_input_is_one_line_naming_it_with_exit_code_2(tmp_path, files, capsy
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written, no --out folder left
 
 
-def test_a_broken_model_is_one_line(tmp_path, capsys, monkeypatch):
-    import drake_biped.model as model
-
-    (tmp_path / "package.xml").write_text('<?xml version="1.0"?><package format="2"><name>drake_biped</name>'
-                                          "</package>")
-    (tmp_path / "biped.urdf").write_text("<robot name='x'><link name='a'></robot>")
-    monkeypatch.setattr(model, "model_package_xml", lambda: tmp_path / "package.xml")
-    code, lines = run_cli(capsys, ["walk", "--distance", "0.1", "--no-animation", "--out", str(tmp_path / "w")])
+@pytest.mark.parametrize("name, text, message", [
+    ("broken.urdf", "<robot name='x'><link name='a'></robot>", "could not parse the model broken.urdf"),
+    ("empty.urdf", "<robot name='x'><link name='a'/></robot>", "the model has no joint named"),
+    ("missing.urdf", None, "--model '{path}': no such file"),
+    ("robot.obj", "v 0 0 0", "--model '{path}': not a .urdf or .sdf file"),
+])
+def test_a_broken_model_is_one_line(tmp_path, capsys, name, text, message):
+    path = tmp_path / name
+    if text is not None:
+        path.write_text(text)
+    code, lines = run_cli(capsys, ["walk", "--model", str(path), "--distance", "0.1", "--no-animation",
+                                   "--out", str(tmp_path / "w")])
     assert code == 2
-    one_line(lines, "could not parse the biped model")
+    one_line(lines, message.format(path=path))
+    assert not (tmp_path / "w").exists()
 
 
 def test_a_failed_run_is_one_line_with_exit_code_1_and_a_traceback_on_request(tmp_path, capsys, monkeypatch):

@@ -154,6 +154,6 @@ def test_shipped_specs_and_parameter_files_are_valid():
         for point in grid_points(load_spec(name)):
             point_config(EpisodeConfig(), point)
     assert gait_names() == ["attracting", "climbing", "climbing_2deg", "coasting", "coasting_garb", "coasting_wide",
-                            "paper"]
+                            "paper", "paper_entrained"]
     for name in ("climbing", "climbing_2deg"):  # the climbing gaits differ from the default by the grid's axes
         assert load_gait(name).gait.torso_pitch_rad < EpisodeConfig().gait.torso_pitch_rad

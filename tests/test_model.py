@@ -70,14 +70,14 @@ def test_only_feet_collide_with_a_heel_and_a_toe_each(plant):
     assert {name: n for name, n in colliding.items() if n} == {"left_foot": 2, "right_foot": 2}
 
 
-def test_malformed_model_is_a_clear_error(tmp_path):
+def test_malformed_model_is_a_clear_error():
     from pydrake.systems.framework import DiagramBuilder
 
-    bad = tmp_path / "package.xml"
-    bad.write_text('<?xml version="1.0"?><package format="2"><name>drake_biped</name></package>')
-    (tmp_path / "biped.urdf").write_text("<robot name='x'><link name='a'></robot>")
-    with pytest.raises(ModelError, match="could not parse"):
-        add_biped(DiagramBuilder(), Ground(), 1e-3, package_xml=bad)
+    from drake_biped.params import RobotModel
+
+    broken = RobotModel("broken.urdf", "<robot name='x'><link name='a'></robot>")
+    with pytest.raises(ModelError, match="could not parse the model broken.urdf"):
+        add_biped(DiagramBuilder(), Ground(), 1e-3, broken)
 
 
 @pytest.mark.parametrize("ground, x, expected_height", [
@@ -131,48 +131,145 @@ def test_only_drakes_half_space_warning_is_dropped(caplog):
                                                          "another warning"]
 
 
-def _model_copy(tmp_path, edit) -> Path:
-    """A copy of the shipped model package with `edit` applied to the URDF text; its package.xml."""
+def _model_file(tmp_path, edit, name="biped.urdf") -> Path:
+    """A copy of the shipped URDF with `edit` applied to its text, in tmp_path; its path."""
     from drake_biped.resources import model_package_xml
 
-    shipped = model_package_xml().parent
-    for name in ("package.xml", "biped.urdf"):
-        text = (shipped / name).read_text()
-        (tmp_path / name).write_text(edit(text) if name == "biped.urdf" else text)
-    return tmp_path / "package.xml"
+    path = tmp_path / name
+    path.write_text(edit((model_package_xml().parent / "biped.urdf").read_text()))
+    return path
 
 
-def test_a_heavier_torso_is_the_mass_of_the_cost_of_transport(tmp_path, monkeypatch):
-    """Physics from the model: with the torso 2 kg heavier in the URDF, the episode reports the model's
+def test_the_shipped_body_is_read_from_the_plant_as_the_kinematics_constants():
+    """The controller's body is read from the model; for the shipped one it is the documented constants,
+    bit for bit (so every number of the default walk is the one the constants gave)."""
+    from drake_biped.kinematics import TABLE_I_BODY
+    from drake_biped.model import body_of_model
+
+    assert np.array_equal(body_of_model(), TABLE_I_BODY)
+
+
+def test_a_heavier_torso_is_the_mass_of_the_cost_of_transport(tmp_path):
+    """Physics from the model: with the torso 2 kg heavier in a user's URDF, the episode reports the model's
     mass, and C_mt is the positive work over that mass's weight times the distance."""
     import drake_biped.model as model
     from drake_biped.episode import run_episode
-    from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, SimulationParams
+    from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, RobotModel, SimulationParams
 
-    heavier = _model_copy(tmp_path, lambda t: t.replace('<mass value="6.646"/>', '<mass value="8.646"/>', 1))
-    monkeypatch.setattr(model, "model_package_xml", lambda: heavier)
-    assert model.link_masses_of(model.build_plant()).total == pytest.approx(TOTAL_MASS_KG + 2.0, abs=1e-12)
-    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=1.0, max_time_s=6.0)), cache=None)
+    heavier = RobotModel.from_file(_model_file(tmp_path, lambda t: t.replace('<mass value="6.646"/>',
+                                                                             '<mass value="8.646"/>', 1)))
+    assert model.link_masses_of(model.build_plant(model=heavier)).total == pytest.approx(TOTAL_MASS_KG + 2.0,
+                                                                                        abs=1e-12)
+    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=1.0, max_time_s=6.0), model=heavier), cache=None)
     assert r.mass_kg == pytest.approx(12.202, abs=1e-12)
     assert r.distance_m > 0.3
     assert r.cost_of_transport == pytest.approx(r.total_positive_work_j / (12.202 * GRAVITY_MPS2 * r.distance_m))
     assert r.cost_of_transport_per_kg == pytest.approx(r.total_positive_work_j / (12.202 * r.distance_m))
+    assert r.config["model"]["name"] == "biped.urdf"
+    assert r.config["model"]["sha256"] == heavier.sha256
+
+
+def _both_legs(text: str, old: str, new: str) -> str:
+    assert text.count(old) == 2
+    return text.replace(old, new)
+
+
+@pytest.mark.parametrize("edit, field, value", [
+    (lambda t: _both_legs(t, '<origin xyz="0 0 -0.317"/>', '<origin xyz="0 0 -0.337"/>'), "ankle_z_m", -0.337),
+    (lambda t: _both_legs(t, '<origin xyz="0 0 -0.28"/>', '<origin xyz="0 0 -0.30"/>'), "knee_z_m", -0.30),
+    (lambda t: _both_legs(t, '<origin xyz="0.0000 0 -0.1400"/>', '<origin xyz="0.0100 0 -0.1300"/>'),
+     "thigh_com_offset_x_m", 0.01),
+    (lambda t: _both_legs(t, '<origin xyz="0.1200 0.0000 -0.0200"/>', '<origin xyz="0.1500 0.0000 -0.0200"/>'),
+     "toe_x_m", 0.15),
+    (lambda t: t.replace('<origin xyz="0 0.06 0"/>', '<origin xyz="0.02 0.06 -0.01"/>')
+     .replace('<origin xyz="0 -0.06 0"/>', '<origin xyz="0.02 -0.06 -0.01"/>'), "hip_x_m", 0.02),
+])
+def test_a_changed_body_is_read_from_the_plant_and_its_kinematics_agrees_with_it(tmp_path, edit, field, value):
+    """Own robot: a model with other lengths, centres of mass or contact points is read, not refused, and the
+    controller's planar kinematics of it agrees with MultibodyPlant at random configurations."""
+    from drake_biped.kinematics import BODY, center_of_mass, leg_points
+    from drake_biped.model import FOOT_BODIES, body_of_model
+    from drake_biped.params import RobotModel
+
+    model = RobotModel.from_file(_model_file(tmp_path, edit))
+    body = body_of_model(model)
+    assert body[BODY.offset(field)] == pytest.approx(value, abs=1e-12)
+    plant = build_plant(model=model)
+    ctx = plant.CreateDefaultContext()
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q = rng.uniform(-0.6, 0.6, 9)
+        plant.SetPositions(ctx, q)
+        for i, leg in ((3, "left"), (6, "right")):
+            p = leg_points(*q[:3], *q[i:i + 3], body)
+            ankle = plant.GetJointByName(f"{leg}_ankle").frame_on_child().CalcPoseInWorld(ctx).translation()
+            assert (p.ankle_x, p.ankle_z) == pytest.approx((ankle[0], ankle[2]), abs=1e-12)
+            # the toe sphere's lowest point: its centre (the sole plus a radius above it) less a radius
+            foot = plant.GetBodyByName(FOOT_BODIES[0 if leg == "left" else 1]).body_frame()
+            radius = body[BODY.offset("toe_radius_m")]
+            centre = foot.CalcPoseInWorld(ctx).multiply(np.array([body[BODY.offset("toe_x_m")], 0.0,
+                                                                  body[BODY.offset("toe_sole_z_m")] + radius]))
+            assert (p.toe_x, p.toe_z) == pytest.approx((centre[0], centre[2] - radius), abs=1e-12)
+        com = plant.CalcCenterOfMassPositionInWorld(ctx)
+        assert center_of_mass(q, body) == pytest.approx((com[0], com[2]), abs=1e-12)
 
 
 @pytest.mark.parametrize("old, new, match", [
-    ('<origin xyz="0 0 -0.317"/>', '<origin xyz="0 0 -0.330"/>', r"left ankle position in the shank frame .* is \[0\.0, -0\.33\]"),
-    ('<origin xyz="0.0000 0 -0.1400"/>', '<origin xyz="0.0000 0 -0.1300"/>', "left thigh centre of mass"),
-    ('<origin xyz="0.1200 0.0000 -0.0200"/>', '<origin xyz="0.1300 0.0000 -0.0200"/>', "left foot contact spheres"),
+    ('<origin xyz="0 0 -0.317"/>', '<origin xyz="0 0 -0.330"/>',
+     r"the legs differ: the left ankle position in the shank frame is \[0\.0, -0\.33\] m, the right \[0\.0, -0\.317\]"),
+    ('<origin xyz="0.0000 0 -0.1400"/>', '<origin xyz="0.0000 0 -0.1300"/>', "the legs differ: the left thigh centre"),
+    ('<origin xyz="0.1200 0.0000 -0.0200"/>', '<origin xyz="0.1300 0.0000 -0.0200"/>', "the legs differ: the left toe"),
     ('<mass value="0.707"/>', '<mass value="0.800"/>', "the legs' masses differ"),
+    ('<mass value="6.646"/>', '<mass value="0"/>', "link torso has mass 0.0 kg; every link"),
     ('<joint name="left_knee" type="revolute">', '<joint name="left_knee_joint" type="revolute">',
-     "left_knee"),
+     r"biped.urdf:\d+: .*joint 'left_knee'"),
+    ('<link name="left_shank">', '<link name="left_lower_leg">', "left_shank"),
 ])
-def test_a_model_the_kinematics_does_not_match_is_refused_by_name(tmp_path, old, new, match):
+def test_a_model_the_toolkit_cannot_read_is_refused_by_name(tmp_path, old, new, match):
     from pydrake.systems.framework import DiagramBuilder
 
-    package = _model_copy(tmp_path, lambda t: t.replace(old, new, 1))
+    from drake_biped.params import RobotModel
+
+    def edit(text):
+        assert old in text
+        return text.replace(old, new, 1).replace('link="left_shank"', 'link="left_lower_leg"') \
+            if "left_lower_leg" in new else text.replace(old, new, 1)
+
+    model = RobotModel.from_file(_model_file(tmp_path, edit))
     with pytest.raises(ModelError, match=match):
-        add_biped(DiagramBuilder(), Ground(), 1e-3, package_xml=package)
+        add_biped(DiagramBuilder(), Ground(), 1e-3, model)
+
+
+def test_a_knee_turning_the_other_way_is_refused_by_name(tmp_path):
+    from drake_biped.params import RobotModel
+
+    def flip(text):
+        return text.replace('<origin xyz="0 0 -0.28"/>\n    <axis xyz="0 1 0"/>',
+                            '<origin xyz="0 0 -0.28"/>\n    <axis xyz="0 -1 0"/>')
+
+    model = RobotModel.from_file(_model_file(tmp_path, flip))
+    with pytest.raises(ModelError, match=r"joint left_knee turns about \[0\.0, -1\.0, 0\.0\]"):
+        build_plant(model=model)
+
+
+def test_package_uris_in_a_users_model_resolve_through_the_package_xml_beside_it(tmp_path):
+    """A user's model may name its files by package:// URIs: the package.xml beside it resolves them."""
+    from drake_biped.params import RobotModel
+
+    (tmp_path / "package.xml").write_text('<?xml version="1.0"?><package format="2"><name>my_robot</name>'
+                                          "<version>0.0.1</version><description>d</description>"
+                                          '<maintainer email="a@b.c">a</maintainer><license>BSD</license></package>')
+    (tmp_path / "box.obj").write_text("v 0 0 0\nv 0.01 0 0\nv 0 0.01 0\nv 0 0 0.01\nf 1 2 3\nf 1 2 4\nf 1 3 4\n"
+                                      "f 2 3 4\n")
+    mesh = '<visual><geometry><mesh filename="package://my_robot/box.obj"/></geometry></visual>'
+    path = _model_file(tmp_path, lambda t: t.replace('<link name="torso">', f'<link name="torso">{mesh}', 1),
+                       "mine.urdf")
+    model = RobotModel.from_file(path)
+    assert model.package_xml == str(tmp_path / "package.xml")
+    assert build_plant(model=model).num_positions() == 9
+    lone = RobotModel(model.name, model.text)  # the same text without its package: the URI is named
+    with pytest.raises(ModelError, match="my_robot"):
+        build_plant(model=lone)
 
 
 def _collision_grounds(ground):
@@ -236,3 +333,35 @@ def test_a_walk_with_a_level_length_on_level_ground_is_the_walk_without_it():
     with_level = run_episode(EpisodeConfig(sim=sim, ground=Ground(level_length_m=5.0)))
     assert with_level.cost_of_transport == plain.cost_of_transport
     assert with_level.distance_m == plain.distance_m
+
+
+def test_walk_with_a_model_file_from_another_folder(tmp_path, monkeypatch, capsys):
+    """`drake-biped walk --model heavy.urdf` from a folder of the user's: the model's mass, C_mt with it, and
+    the file named (with its SHA-256) in result.json; a model with longer shanks is walked, not refused."""
+    import hashlib
+    import json
+
+    from drake_biped.cli import main
+    from drake_biped.params import GRAVITY_MPS2
+
+    heavy = _model_file(tmp_path, lambda t: t.replace('<mass value="6.646"/>', '<mass value="8.646"/>', 1),
+                        "heavy.urdf")
+    longer = _model_file(tmp_path, lambda t: _both_legs(t, '<origin xyz="0 0 -0.317"/>', '<origin xyz="0 0 -0.337"/>'),
+                         "longer.urdf")
+    monkeypatch.chdir(tmp_path)
+    assert main(["walk", "--model", "heavy.urdf", "--distance", "1", "--no-animation", "--out", "D"]) == 0
+    r = json.loads((tmp_path / "D" / "result.json").read_text())
+    assert r["mass_kg"] == pytest.approx(12.202, abs=1e-12)
+    work = r["positive_work_j"]["total"]
+    assert r["cost_of_transport"] == pytest.approx(work / (12.202 * GRAVITY_MPS2 * r["distance_m"]), rel=1e-12)
+    assert r["config"]["model"]["name"] == "heavy.urdf"
+    assert r["config"]["model"]["sha256"] == hashlib.sha256(heavy.read_bytes()).hexdigest()
+    assert main(["walk", "--model", str(longer), "--distance", "1", "--no-animation", "--out", "L"]) == 0
+    r = json.loads((tmp_path / "L" / "result.json").read_text())
+    assert r["termination"] in ("distance", "fall") and r["config"]["model"]["name"] == "longer.urdf"
+    # the result.json walks again by --params, carrying its model
+    assert main(["walk", "--params", "D/result.json", "--no-animation", "--out", "D2"]) == 0
+    first = json.loads((tmp_path / "D" / "result.json").read_text())
+    again = json.loads((tmp_path / "D2" / "result.json").read_text())
+    assert again["cost_of_transport"] == first["cost_of_transport"]
+    assert again["config"]["model"]["sha256"] == first["config"]["model"]["sha256"]

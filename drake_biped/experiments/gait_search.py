@@ -30,7 +30,13 @@ walks, by the objective:
 - "landscape": the same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s)
   through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the
   best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes
-  (stability's, without a window) the gait does not walk through.
+  (stability's, without a window) the gait does not walk through;
+- "robust": how far the walk without a window is from holding when the simulation is refined or the start is
+  nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the
+  distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation
+  speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change
+  over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all
+  hold.
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
@@ -116,7 +122,10 @@ COAST_MUTATIONS = {
 }
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
                  "coast": COAST_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape")
+OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape", "robust")
+# The "robust" objective's changes to the walk without a window, and the half step's allowed C_mt change.
+ROBUST_CHECKS = ("half_step", "speed_0.95", "speed_1.05", "push_forward", "push_backward")
+ROBUST_CMT_CHANGE = 0.02
 # Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
 COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
@@ -239,11 +248,33 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                    "landscape": {"start_gain": start_gain, "best_gain": best_gain, "best_mean": land["best_mean"]}}
 
 
+def _robust_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "robust" objective (module docstring) and what it measured; `base` may be a fall."""
+    plain = config.replace(window=TorqueFreeWindow())
+    speed = config.initial.speed_mps
+    rows = {"half_step": _walk(plain.override({"sim.time_step_s": 0.5 * config.sim.time_step_s})),
+            "speed_0.95": _walk(plain.override({"initial.speed_mps": 0.95 * speed})),
+            "speed_1.05": _walk(plain.override({"initial.speed_mps": 1.05 * speed}))}
+    forward, backward = _push_rows(config)
+    rows["push_forward"], rows["push_backward"] = forward, backward
+    distance = config.sim.distance_m
+    fractions = [min(1.0, max(0.0, r["distance_m"]) / distance) for r in (base, *rows.values())]
+    change = None
+    excess = 1.0
+    if base["walked"] and rows["half_step"]["walked"]:
+        change = rows["half_step"]["cost_of_transport"] / base["cost_of_transport"] - 1.0
+        excess = min(1.0, max(0.0, abs(change) - ROBUST_CMT_CHANGE) / ROBUST_CMT_CHANGE)
+    value = (sum(fractions) / len(fractions) - 1.0) - excess / (len(ROBUST_CHECKS) + 1)
+    return value, {"baseline": base, "windows": [], "checks": rows, "half_step_cmt_change": change}
+
+
 def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows",
           draws: int = POLICY_DRAWS) -> tuple[float, dict[str, Any]]:
     """The search objective (module docstring) and what it measured; `draws`: how many draws of the start
     policy the "policy" and "expected" objectives walk."""
     base = _walk(config.replace(window=TorqueFreeWindow()))
+    if objective == "robust":
+        return _robust_score(config, base)
     if not base["walked"]:
         return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
             {"baseline": base, "windows": []}

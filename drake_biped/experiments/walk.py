@@ -195,5 +195,8 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
         write_meshcat_html(meshcat, out / "walk.html", follow=(result.trajectory["time"],
                                                              result.trajectory["positions"][:, 0]),
                            ground_height=config.ground.height)
-        walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height)
+        from drake_biped.model import body_of_model
+
+        walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height,
+                       body=body_of_model(config.model))
     return result
