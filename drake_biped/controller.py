@@ -209,7 +209,10 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
                  "torso_kp", "torso_kd", "torso_pitch_rad", "stance_knee_torque", "ankle_kp", "ankle_kd"):
         put(name, getattr(g, name))
     put("knee_law", knee_law(g))
-    put("touchdown_rule", touchdown_rule(g))
+    rule = touchdown_rule(g)
+    if g.phase_reading == "entrained":  # the phase does not follow the steps: no phase condition
+        rule = (*rule[:3], -math.inf)
+    put("touchdown_rule", rule)
     put("window_start_s", w.start_s)
     put("window_end_s", w.end_s)
     put("window_first_step", w.first_step)
@@ -230,6 +233,15 @@ TOUCHED, FELL, DONE_BIT = 1, 2, 4
 # Leg points tuple (kinematics.leg_points_k): the slots the update reads.
 _KNEE_X, _KNEE_Z, _ANKLE_X, _HEEL_X, _HEEL_Z, _TOE_X, _TOE_Z, _THIGH, _FOOT, _HIP_X, _HIP_Z = 0, 1, 2, 4, 5, 6, 7, 8, 10, \
     11, 12
+
+
+@njit
+def legs_k(right_stance: bool, left: tuple, right: tuple) -> tuple:
+    """(stance hip's index, swing hip's index in q and v, stance leg's points, swing leg's points) when the
+    right leg is the stance leg or not."""
+    if right_stance:
+        return Q_HIP_RIGHT, Q_HIP_LEFT, right, left
+    return Q_HIP_LEFT, Q_HIP_RIGHT, left, right
 
 
 @njit
@@ -377,21 +389,11 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     right = leg_points_k(body, px, pz, pitch, q[6], q[7], q[8])
     entrained = law[L_ENTRAINED] != 0.0
     stance_right = s[STANCE_RIGHT] > 0.5
-    if stance_right:
-        st_i, sw_i = Q_HIP_RIGHT, Q_HIP_LEFT
-        stance, swing = right, left
-    else:
-        st_i, sw_i = Q_HIP_LEFT, Q_HIP_RIGHT
-        stance, swing = left, right
+    st_i, sw_i, stance, swing = legs_k(stance_right, left, right)
     # The legs by contact (the foot that landed last, and the other): the same as the roles but under the
     # entrained phase reading, where the phase swaps the roles and a touchdown only marks T_n.
     contact_right = s[CONTACT_RIGHT] > 0.5
-    if contact_right:
-        cst_i, csw_i = Q_HIP_RIGHT, Q_HIP_LEFT
-        c_stance, c_swing = right, left
-    else:
-        cst_i, csw_i = Q_HIP_LEFT, Q_HIP_RIGHT
-        c_stance, c_swing = left, right
+    cst_i, csw_i, c_stance, c_swing = legs_k(contact_right, left, right)
     com_x = center_of_mass_k(body, px, pz, pitch, left, right)[0]
     s[COM_X] = com_x
 
@@ -406,7 +408,7 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     s[PREV_RATES + 1] = rate_1
     s[PREV_RATES] = v[csw_i] - v[cst_i]  # the section rate, were the swing foot to land now
     rule = (law[L_TOUCHDOWN], law[L_TOUCHDOWN + 1], law[L_TOUCHDOWN + 2], law[L_TOUCHDOWN + 3])
-    touched = is_touchdown_k(rule, now - s[STEP_START], clearance, advance, math.pi if entrained else s[GAMMA])
+    touched = is_touchdown_k(rule, now - s[STEP_START], clearance, advance, s[GAMMA])
     if touched:
         contact_right = not contact_right
         cst_i, csw_i = csw_i, cst_i

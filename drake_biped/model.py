@@ -36,7 +36,6 @@ from drake_biped.kinematics import (
     center_of_mass_k,
     leg_points_k,
     link_masses,
-    masses_of,
 )
 from drake_biped.params import GRAVITY_MPS2, Ground, RobotModel
 from drake_biped.resources import model_package_xml
@@ -80,12 +79,7 @@ class ModelError(RuntimeError):
 class PlantHandles:
     plant: MultibodyPlant
     scene_graph: SceneGraph
-    body: np.ndarray  # kinematics.BODY, read from the model (`body_of`): the controller and the centre of mass
-
-    @property
-    def masses(self) -> LinkMasses:
-        """The model's link masses: every per-kg figure uses these."""
-        return masses_of(self.body)
+    body: np.ndarray  # kinematics.BODY, read from the model (`body_of`): its masses are every per-kg figure's
 
 
 def add_biped(
