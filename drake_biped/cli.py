@@ -627,9 +627,11 @@ def build_parser() -> argparse.ArgumentParser:
                              "(the paper's start policy's expected gain on a coarse window map, half the best "
                              "mean's up to 0.2, less 0.25 a failed 20 N push), 'robust' (how far the walk is from "
                              "holding at half the plant step, from 0.95 and 1.05 x the initiation speed and under "
-                             "+-20 N pushes; 0 once all hold)")
+                             "+-20 N pushes; 0 once all hold), 'story' ('robust' first, then 'policy' with each "
+                             "draw judged at the step and half the step and the best draw from 0.95 and 1.05 x "
+                             "the initiation speed)")
     search.add_argument("--policy-draws", type=_count, default=12,
-                        help="draws of the paper's start policy the 'policy' and 'expected' objectives walk "
+                        help="draws of the paper's start policy the 'policy', 'expected' and 'story' objectives walk "
                              "(default 12; a draw with t2 <= t1 is no window and costs no episode)")
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)

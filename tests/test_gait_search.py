@@ -254,3 +254,51 @@ def test_landscape_objective_is_the_start_policys_gain_and_counts_failed_pushes(
     assert detail["landscape"]["best_gain"] == pytest.approx(1.0, abs=0.02)
     assert value == pytest.approx(detail["landscape"]["start_gain"] + 0.5 * gait_search.BEST_GAIN_CAP
                                   - gait_search.PUSH_PENALTY)
+
+
+def _fake_story_walk(half_step_cmt=0.2, fall_at_fast_start=False):
+    """A stand-in walk: no window costs 0.2; a window halves it at the 1 ms step but saves only 25 % at half
+    the step and 10 % from 0.95 x the initiation speed; the walk from 1.05 x the speed falls when asked."""
+    def walk(config):
+        step, speed = config.sim.time_step_s, config.initial.speed_mps
+        fast, slow = speed > 1.01 * 0.175, speed < 0.99 * 0.175
+        if fall_at_fast_start and fast:
+            return {"walked": False, "cost_of_transport": 0.2, "distance_m": 2.5, "reward": 0.25 / 0.2}
+        if not config.window.active:
+            cmt = half_step_cmt if step < 0.001 else 0.2
+        elif step < 0.001:
+            cmt = 0.15
+        else:
+            cmt = 0.18 if slow else 0.1
+        return {"walked": True, "cost_of_transport": cmt, "distance_m": 10.0, "reward": 1.0 / cmt}
+    return walk
+
+
+def test_robust_objective_counts_the_distance_walked_and_the_half_steps_cmt_change(monkeypatch):
+    """All checks walk: 0, less 1/6 when the half step changes C_mt by 5 % (capped excess 1); a check that
+    falls at a quarter of the distance takes (1/4 - 1)/6 from the mean fraction walked."""
+    config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
+    monkeypatch.setattr(gait_search, "_walk", _fake_story_walk())
+    assert gait_search.score(config, objective="robust")[0] == 0.0
+    monkeypatch.setattr(gait_search, "_walk", _fake_story_walk(half_step_cmt=0.21))
+    value, detail = gait_search.score(config, objective="robust")
+    assert detail["half_step_cmt_change"] == pytest.approx(0.05)
+    assert value == pytest.approx(-1.0 / 6.0)
+    monkeypatch.setattr(gait_search, "_walk", _fake_story_walk(fall_at_fast_start=True))
+    assert gait_search.score(config, objective="robust")[0] == pytest.approx((0.25 - 1.0) / 6.0)
+
+
+def test_story_objective_judges_each_draw_where_it_saves_least(monkeypatch):
+    """The robust checks hold: each drawn window's gain is its gain at half the step (1/3, not 1), and the best
+    draw's is its gain from 0.95 x the initiation speed (1/9); a gait that fails a robust check scores below -2."""
+    config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
+    monkeypatch.setattr(gait_search, "_walk", _fake_story_walk())
+    value, detail = gait_search.score(config, objective="story")
+    windowed = sum(1 for t1, t2 in policy_draws() if t2 > t1)
+    d = gait_search.distance_from_table_iii(config.cpg)
+    assert detail["gains"] == pytest.approx([1.0 / 3.0 if t2 > t1 else 0.0 for t1, t2 in policy_draws()])
+    assert detail["best_draw"]["gain"] == pytest.approx(1.0 / 9.0)
+    assert value == pytest.approx(windowed / 12 / 3.0 + 0.5 / 9.0 - 0.01 * d / (1.0 + d))
+    monkeypatch.setattr(gait_search, "_walk", _fake_story_walk(fall_at_fast_start=True))
+    value, _ = gait_search.score(config, objective="story")
+    assert value == pytest.approx((0.25 - 1.0) / 6.0 - 2.0)
