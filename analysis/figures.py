@@ -12,6 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from drake_biped.analysis import rewalks  # noqa: E402
 from drake_biped.analysis.series import moving_average, period  # noqa: E402
 from drake_biped.kinematics import B_TORSO_COM_X, B_TORSO_COM_Z, TABLE_I_BODY, leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
@@ -307,6 +308,8 @@ def table_v(record: dict) -> str:
     for r in ev.get("learned", []):
         lines.append(f"| {r['trial']} | {r['t1']:.3f} | {r['t2']:.3f} | {fmt(r['cost_of_transport'])} | "
                      f"{'yes' if not r['fell'] else 'no'} |")
+    if ev.get("rewalks"):
+        lines += ["", "## The learned windows re-walked", "", rewalks.markdown(ev["rewalks"]).rstrip()]
     return "\n".join(lines) + "\n"
 
 

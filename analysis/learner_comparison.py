@@ -4,6 +4,8 @@ The ground truth is the window map's best walking window (lowest C_mt among the 
 learning run (a learning.json record) and that window:
 - final C_mt: the mean over trials of the evaluated final policy means that walk, and its reduction against
   no window;
+- re-walked saving: the mean over trials of each final mean's saving re-walked with the plant step halved and
+  from 0.95 and 1.05 x the initiation speed, its spread and the trials that hold (`drake_biped.analysis.rewalks`);
 - distance: of each trial's final mean to the best window (s), its mean;
 - episodes to within 5 %: the first episode at which the trial's running C_mt (the mean over the last
   RUNNING episodes that walked) is within 5 % of the best window's; None where it never is;
@@ -54,6 +56,7 @@ def compare(record: dict[str, Any], best: dict[str, Any] | None, tolerance: floa
     """One learner's row (module docstring) from its learning record and the best window's map row (None
     when no window of the map walks: then there is no distance and no episode count to report)."""
     ev = record["evaluation"]
+    rewalks = ev.get("rewalks") or {}
     means = np.array([t["final_mean"] for t in record["trials"]], dtype=float)
     if best is None:
         distance = np.full(len(means), math.nan)
@@ -66,6 +69,9 @@ def compare(record: dict[str, Any], best: dict[str, Any] | None, tolerance: floa
         "final_cost_of_transport": ev.get("learned_mean_cost_of_transport"),
         "reduction": ev.get("reduction"),
         "learned_walks": ev.get("learned_walks"),
+        "rewalked_saving": rewalks.get("mean_saving"),
+        "rewalked_saving_std": rewalks.get("std_saving"),
+        "rewalked_holding": rewalks.get("holding"),
         "trials": len(record["trials"]),
         "mean_distance_to_best_s": None if best is None else float(np.mean(distance)),
         "distance_to_best_s": None if best is None else distance.tolist(),

@@ -1,4 +1,4 @@
-"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | compare-learners | figures | landscape | stability | floquet | push-margin | grid | slope | reproduce`.
+"""Command-line interface: `drake-biped walk | window-map | gait-search | time-step-study | learn | compare-learners | figures | landscape | stability | rewalk | floquet | push-margin | grid | slope | reproduce`.
 
 Parsing only: each command turns its options into its experiment's settings and calls the experiment's
 `run(settings, out, client)` (drake_biped.experiments), which writes every file. Every numeric option is
@@ -357,6 +357,25 @@ def cmd_floquet(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_rewalk(args: argparse.Namespace) -> int:
+    from drake_biped.analysis.rewalks import markdown
+    from drake_biped.experiments.learning import check_learning_record
+    from drake_biped.experiments.rewalk import rewalk_record
+    from drake_biped.records import read_json, write_atomic, write_text_atomic
+
+    # What is not a learning record is refused before a cluster starts.
+    check_learning_record(read_json(Path(args.policy), "--policy"), f"--policy {args.policy}")
+    out = Path(args.out)
+    with _client(args) as client:
+        record = rewalk_record(Path(args.policy), client)
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "rewalk.json", record)
+    write_text_atomic(out / "rewalk.md", markdown(record))
+    print(markdown(record))
+    print(f"wrote {out}/rewalk.json, rewalk.md")
+    return 0
+
+
 def cmd_push_margin(args: argparse.Namespace) -> int:
     from drake_biped.experiments import push_margin
 
@@ -712,6 +731,14 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_options(pm)
     pm.add_argument("--out", required=True, type=_out_folder, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
+
+    rw = sub.add_parser("rewalk", help="a learning run's final policy means re-walked with the plant step halved "
+                        "and from 0.95 and 1.05 x the initiation speed, each against no window under the same "
+                        "change, on Dask")
+    rw.add_argument("--policy", required=True, help="the learning.json of drake-biped learn")
+    _add_cluster_options(rw)
+    rw.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    rw.set_defaults(func=cmd_rewalk)
 
     fl = sub.add_parser("floquet", help="the gait's periodic orbit (Newton on the full-state step map) and its "
                         "Floquet multipliers by central differences through Drake, on Dask")

@@ -4,10 +4,14 @@ The ground is level for `level_length_m` (2 m), then ascends at `slope_rad`. An 
 reaches the episode's distance (10 m: 2 m level, 8 m up) without falling. Three questions, each answered by
 episodes on that ground:
 
-1. Does the torque-free period learned on level ground climb? (one episode with the starting policy's mean)
-2. Does the gait without a torque-free period climb? (one episode)
+1. Does the torque-free period learned on level ground climb? (the starting policy's mean)
+2. Does the gait without a torque-free period climb?
 3. Online GARB learning on the slope, starting from the learned policy: does it shrink the period until it
-   climbs? (`trials` independent runs of `episodes` each; then one episode with each final policy mean)
+   climbs? (`trials` independent runs of `episodes` each; then each final policy mean)
+
+Each answer is walked four times: as learned, with the plant step halved, and from 0.95 and 1.05 x the
+initiation speed (`drake_biped.experiments.rewalk`); a claim holds only when it holds in all four (a walk that
+climbs only in one simulation, from one start, does not climb).
 
 The learner starts from the learned policy's state: its mean, variance and eligibility trace. The paper
 says "the learning algorithm and α_p were not changed"; here the episode count starts again at 1 on the new
@@ -29,8 +33,10 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.rewalks import CHANGE_WORDS, CHANGES
 from drake_biped.analysis.series import moving_average, period
 from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
+from drake_biped.experiments.rewalk import changed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
 from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow
@@ -74,11 +80,19 @@ def start_from_window(t1: float, t2: float, variance: float) -> tuple[dict[str, 
     return GarbLearner((t1, t2), variance, seed=0).state(), {"window": [t1, t2], "variance": variance}
 
 
-def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[str, dict[str, Any]]:
-    """One episode per named configuration, kept in OUT/checks/ and reused when its configuration matches."""
+def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[str, dict[str, dict[str, Any]]]:
+    """Each named configuration walked as learned and under every re-walk change, kept in OUT/checks/
+    (NAME.json as learned, NAME.CHANGE.json) and reused when its configuration matches: {name: {change:
+    result}}."""
     from drake_biped.experiments.executor import run_kept
 
-    return run_kept(client, {name: (out / "checks" / f"{name}.json", c.to_dict()) for name, c in configs.items()})
+    files = {}
+    for name, c in configs.items():
+        for change in CHANGES:
+            stem = name if change == "as_learned" else f"{name}.{change}"
+            files[name, change] = (out / "checks" / f"{stem}.json", changed(c, change).to_dict())
+    results = run_kept(client, files)
+    return {name: {change: results[name, change] for change in CHANGES} for name in configs}
 
 
 def climbs(result: dict[str, Any]) -> bool:
@@ -89,6 +103,14 @@ def climbs(result: dict[str, Any]) -> bool:
 def _summary(result: dict[str, Any]) -> dict[str, Any]:
     keep = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps")
     return {**{k: result[k] for k in keep}, "climbs": climbs(result)}
+
+
+def _rewalks(walks: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """A check's re-walks (besides the walk as learned): each change's summary, and whether all four climb or
+    none does."""
+    rows = {change: _summary(walks[change]) for change in CHANGES[1:]}
+    every = [_summary(walks["as_learned"])["climbs"], *(r["climbs"] for r in rows.values())]
+    return {**rows, "all_climb": all(every), "none_climbs": not any(every)}
 
 
 def trial_summary(episodes: list[dict[str, Any]], distance_m: float) -> dict[str, Any]:
@@ -136,20 +158,21 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
     start_period = period(*start.mean)
     trial_rows = []
     for t in runs:
+        final = finals[f"final_trial_{t.index}"]
         row = {"trial": t.index, "learner_seed": trial_seed(seed, t.index), "final_mean": t.learner.mean.tolist(),
                **trial_summary(t.episodes, config.sim.distance_m),
-               "final_policy": _summary(finals[f"final_trial_{t.index}"])}
+               "final_policy": _summary(final["as_learned"]), "final_policy_rewalks": _rewalks(final)}
         trial_rows.append(row)
     record = {
         "settings": settings,
         "ground": ground.to_dict(),
         "start": {**start_source, "mean": start.mean.tolist(), "period_s": start_period,
                   "variance": start.variance},
-        "checks": {name: _summary(r) for name, r in checks.items()},
+        "checks": {name: _summary(r["as_learned"]) for name, r in checks.items()},
+        "rewalks": {name: _rewalks(r) for name, r in checks.items()},
         "trials": trial_rows,
         "episodes": [{"trial": t.index, "episodes": t.episodes} for t in runs],
-        "verdicts": verdicts(_summary(checks["start_window"]), _summary(checks["no_window"]), trial_rows,
-                             start_period),
+        "verdicts": verdicts({name: _rewalks(r) for name, r in checks.items()}, trial_rows, start_period),
         "versions": code,
     }
     write_atomic(out / "slope.json", record)
@@ -158,15 +181,18 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
     return record
 
 
-def verdicts(start: dict[str, Any], none: dict[str, Any], trials: list[dict[str, Any]],
+def verdicts(rewalks: dict[str, dict[str, Any]], trials: list[dict[str, Any]],
              start_period: float) -> dict[str, Any]:
-    """The paper's three claims about the slope, each True/False as measured here."""
-    adapted = [t for t in trials if t["final_policy"]["climbs"] and t["mean_period_end_s"] < start_period]
+    """The paper's three claims about the slope as measured here, each over the four walks of its check
+    (`_rewalks`): the learned period falls in all four, no period climbs in all four, and how many trials end
+    with a shorter period that climbs in all four."""
+    adapted = [t for t in trials if t["final_policy_rewalks"]["all_climb"] and t["mean_period_end_s"] < start_period]
     return {
-        "learned_period_fails_to_climb": (not start["climbs"]) and start_period > 0,
-        "no_period_climbs": none["climbs"],
+        "learned_period_fails_to_climb": rewalks["start_window"]["none_climbs"] and start_period > 0,
+        "no_period_climbs": rewalks["no_window"]["all_climb"],
         "learning_shrinks_the_period_until_it_climbs": len(adapted),
         "trials": len(trials),
+        "judged_over": list(CHANGES),
     }
 
 
@@ -179,6 +205,12 @@ def report_markdown(record: dict[str, Any]) -> str:
         cmt = "" if r["cost_of_transport"] is None else f", C_mt {r['cost_of_transport']:.3f}"
         return f"{how}: {r['distance_m']:.2f} m in {r['duration_s']:.1f} s{cmt}"
 
+    def again(rows: dict[str, Any]) -> str:
+        return ", ".join("climbs" if rows[c]["climbs"] else
+                         f"{'falls' if rows[c]['fell'] else 'stops'} at {rows[c]['distance_m']:.2f} m"
+                         for c in CHANGES[1:])
+
+    rewalked_words = ", ".join(CHANGE_WORDS[c] for c in CHANGES[1:])
     t1, t2 = start["mean"]
     origin = (f"trial {start['trial']} of {start['learning']} (after {start['level_episodes']} level-ground "
               f"episodes)" if "learning" in start else "the given window (no level-ground learning record)")
@@ -189,15 +221,19 @@ def report_markdown(record: dict[str, Any]) -> str:
         f"Starting policy: mean t1 = {t1:.3f} s, t2 = {t2:.3f} s (period {start['period_s']:.3f} s), variance "
         f"{start['variance']:g} s², from {origin}.",
         "",
-        "| claim (paper) | measured here | holds |",
-        "|---|---|---|",
+        f"Each check is walked as learned and re-walked ({rewalked_words}); a claim holds when it holds in all "
+        "four walks.",
+        "",
+        f"| claim (paper) | measured here | re-walked ({rewalked_words}) | holds |",
+        "|---|---|---|---|",
         f"| the learned torque-free period fails to climb | {episode(checks['start_window'])} | "
-        f"{'yes' if v['learned_period_fails_to_climb'] else 'no'} |",
+        f"{again(record['rewalks']['start_window'])} | {'yes' if v['learned_period_fails_to_climb'] else 'no'} |",
         f"| without a torque-free period the robot climbs | {episode(checks['no_window'])} | "
-        f"{'yes' if v['no_period_climbs'] else 'no'} |",
+        f"{again(record['rewalks']['no_window'])} | {'yes' if v['no_period_climbs'] else 'no'} |",
         f"| online learning shrinks the period until it climbs | {v['learning_shrinks_the_period_until_it_climbs']}"
         f" of {v['trials']} trials end with a shorter period that climbs | "
-        f"{'yes' if v['learning_shrinks_the_period_until_it_climbs'] else 'no'} |",
+        + "; ".join(f"trial {t['trial']}: {again(t['final_policy_rewalks'])}" for t in record["trials"])
+        + f" | {'yes' if v['learning_shrinks_the_period_until_it_climbs'] else 'no'} |",
         "",
         f"| trial | episodes | period, first / last {MOVING_AVERAGE} (s) | policy period end (s) | distance, first "
         f"/ last {MOVING_AVERAGE} (m) | climbs in last {MOVING_AVERAGE} | first full {MOVING_AVERAGE}-average | "

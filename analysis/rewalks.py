@@ -1,0 +1,99 @@
+"""Learned torque-free periods re-walked where the learner did not walk them (the record's summary and report;
+the walks: `drake_biped.experiments.rewalk`).
+
+A walk's saving is 1 - C_mt(window) / C_mt(no window) under the same change; where either walk falls it has
+none (a fall is counted, never averaged). A trial's saving is the mean of its four walks' (as learned and the
+three changes); the run's figure is the mean over trials with its standard deviation. A trial holds when every
+one of its four walks walks and saves at least HOLD_SAVING.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from drake_biped.analysis.series import signed_percent
+
+__all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "summary"]
+
+# The walk as learned, then the changes it is re-walked under.
+CHANGES = ("as_learned", "half_step", "speed_0.95", "speed_1.05")
+CHANGE_WORDS = {"as_learned": "as learned", "half_step": "half the plant step",
+                "speed_0.95": "0.95 x the initiation speed", "speed_1.05": "1.05 x the initiation speed"}
+# A learned window holds when it saves at least this much in every re-walk.
+HOLD_SAVING = 0.35
+# What a re-walk keeps of an episode's result.
+KEEP = ("cost_of_transport", "distance_m", "fell", "mean_speed_mps", "step_period_s")
+
+
+def _saving(row: dict[str, Any], base: dict[str, Any]) -> float | None:
+    if row["fell"] or base["fell"] or not row["cost_of_transport"] or not base["cost_of_transport"]:
+        return None
+    return 1.0 - row["cost_of_transport"] / base["cost_of_transport"]
+
+
+def summary(time_step_s: float, speed_mps: float, learned: list[dict[str, Any]],
+            rows: dict[str, dict[Any, dict[str, Any]]]) -> dict[str, Any]:
+    """The re-walks' record from their results (walks at plant step `time_step_s` from `speed_mps`, before the
+    changes). learned: {"trial", "t1", "t2"} per trial; rows[change]: the walk without a window under the change
+    as "no_window", trial k's as k (module docstring)."""
+    trials = []
+    for t in learned:
+        walks = {change: rows[change][t["trial"]] for change in CHANGES}
+        savings = {change: _saving(walks[change], rows[change]["no_window"]) for change in CHANGES}
+        kept = [s for s in savings.values() if s is not None]
+        trials.append({**t, "walks": walks, "savings": savings,
+                       "mean_saving": float(np.mean(kept)) if kept else None,
+                       "least_saving": min(kept) if len(kept) == len(CHANGES) else None,
+                       "falls": len(CHANGES) - len(kept),
+                       "holds": len(kept) == len(CHANGES) and min(kept) >= HOLD_SAVING})
+    means = [t["mean_saving"] for t in trials if t["mean_saving"] is not None]
+    return {
+        "changes": list(CHANGES),
+        "hold_saving": HOLD_SAVING,
+        "time_step_s": time_step_s,
+        "speed_mps": speed_mps,
+        "no_window": {change: rows[change]["no_window"] for change in CHANGES},
+        "trials": trials,
+        "mean_saving": float(np.mean(means)) if means else None,
+        "std_saving": float(np.std(means)) if means else None,
+        "holding": sum(t["holds"] for t in trials),
+    }
+
+
+def _change(saving: float | None) -> str:
+    """A saving as the C_mt change it is ("-45.0 %"), or "falls"."""
+    return "falls" if saving is None else signed_percent(-saving)
+
+
+def markdown(record: dict[str, Any]) -> str:
+    """The re-walks as a table: each trial's saving (C_mt change against no window) under each change."""
+    words = [CHANGE_WORDS[c] for c in record["changes"]]
+    lines = [f"Each learned window re-walked: {', '.join(words)}; each against the walk without a window "
+             f"under the same change (plant step {1e3 * record['time_step_s']:g} ms, initiation "
+             f"{record['speed_mps']:g} m/s). A trial holds when it saves ≥ {100 * record['hold_saving']:.0f} % "
+             "in every walk.", "",
+             "| trial | window (s) | " + " | ".join(words) + " | mean | holds |",
+             "|---|---|" + "---:|" * len(words) + "---:|---|"]
+    base = " | ".join(f"C_mt {r['cost_of_transport']:.4f}" if not r["fell"] else "falls"
+                      for r in record["no_window"].values())
+    lines.append(f"| no window | — | {base} | | |")
+    for t in record["trials"]:
+        cells = " | ".join(_change(t["savings"][c]) for c in record["changes"])
+        lines.append(f"| {t['trial']} | {max(0.0, t['t1']):.3f}–{max(0.0, t['t2']):.3f} | {cells} | "
+                     f"{_change(t['mean_saving'])} | "
+                     f"{'yes' if t['holds'] else 'no'} |")
+    lines += ["", headline(record)]
+    return "\n".join(lines) + "\n"
+
+
+def headline(record: dict[str, Any]) -> str:
+    """One sentence: the mean saving over trials with its spread, and how many trials hold."""
+    n = len(record["trials"])
+    if record["mean_saving"] is None:
+        return f"No trial's window walks under any change ({n} trials)."
+    return (f"C_mt change with the learned windows, re-walked: {signed_percent(-record['mean_saving'])} "
+            f"(± {100 * record['std_saving']:.1f} %, mean over trials of each trial's mean over its "
+            f"{len(record['changes'])} walks); {record['holding']} of {n} trials save ≥ "
+            f"{100 * record['hold_saving']:.0f} % in every walk.")

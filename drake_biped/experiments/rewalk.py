@@ -1,0 +1,74 @@
+"""Learned torque-free periods re-walked where the learner did not walk them: with the plant step halved, and
+from 0.95 and 1.05 x the initiation speed, each against the walk without a window under the same change.
+
+A learner scores windows in one simulation, from one start; a saving that holds only there is an edge of that
+simulation, not a property of the robot. Every learning run (`drake-biped learn`, `compare-learners`,
+`reproduce`) re-walks each trial's final policy mean so, and `drake-biped rewalk --policy learning.json` does it
+for any learning record. What a saving, a trial's figure and holding mean: `drake_biped.analysis.rewalks`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from drake_biped.analysis.rewalks import CHANGES, KEEP, summary
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+
+__all__ = ["changed", "rewalk", "rewalk_record"]
+
+
+def changed(config: EpisodeConfig, change: str) -> EpisodeConfig:
+    """`config` under one of CHANGES: the plant step halved (the control period kept), or the initiation speed
+    scaled."""
+    if change == "as_learned":
+        return config
+    if change == "half_step":
+        return config.override({"sim.time_step_s": 0.5 * config.sim.time_step_s})
+    if change in ("speed_0.95", "speed_1.05"):
+        return config.override({"initial.speed_mps": float(change[6:]) * config.initial.speed_mps})
+    raise ParameterError(f"re-walk change {change!r} is not one of {list(CHANGES)}")
+
+
+def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client) -> dict[str, Any]:
+    """Walk each learned window (`learned`: {"trial", "t1", "t2"}, a policy mean, per trial) and the gait
+    without a window, as learned and under each change, on the Dask `client`: the `summary` record."""
+    from drake_biped.experiments.executor import episode_task
+    from drake_biped.experiments.learning import window_of
+
+    plain = config.replace(window=TorqueFreeWindow())
+    jobs: dict[tuple[str, Any], dict[str, Any]] = {}
+    for change in CHANGES:
+        base = changed(plain, change)
+        jobs[change, "no_window"] = base.to_dict()
+        for t in learned:
+            window = window_of((t["t1"], t["t2"]))
+            if window.active:  # an inactive window is the walk without one
+                jobs[change, t["trial"]] = base.replace(window=window).to_dict()
+    futures = {key: client.submit(episode_task, c, pure=False) for key, c in jobs.items()}
+    results = dict(zip(futures, client.gather(list(futures.values()))))
+    rows: dict[str, dict[Any, dict[str, Any]]] = {change: {} for change in CHANGES}
+    for (change, key), r in results.items():
+        rows[change][key] = {f: r[f] for f in KEEP}
+    for change in CHANGES:
+        for t in learned:
+            rows[change].setdefault(t["trial"], rows[change]["no_window"])
+    return summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows)
+
+
+def rewalk_record(source: Path, client) -> dict[str, Any]:
+    """The re-walks of a learning record's final policy means (`source`: a learning.json), with what they
+    were made from."""
+    from drake_biped.experiments.learning import check_learning_record
+    from drake_biped.records import read_json
+    from drake_biped.versions import versions
+
+    record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
+    try:
+        config = EpisodeConfig.from_dict(record["settings"]["config"])
+        learned = [{"trial": int(t["trial"]), "t1": float(t["final_mean"][0]), "t2": float(t["final_mean"][1])}
+                   for t in record["trials"]]
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise ParameterError(f"--policy {source}: a learning record without its final means ({exc})") from None
+    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client),
+            "versions": versions()}
