@@ -62,6 +62,27 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
     assert {"t1", "t2", "reward", "cost_of_transport", "distance_m", "fell"} <= set(first[0])
 
 
+def test_a_shorter_run_is_replayed_from_a_longer_ones_records(tmp_path, client):
+    """The records of a 1 x 3 run, replayed from a 1 x 5 run of the same settings, are the 1 x 3 run's own
+    to the byte; other settings, or a record the learner cannot have drawn, give none."""
+    from drake_biped.experiments.learning import replay_run
+
+    short, long_ = _settings(episodes=3, trials=1), _settings(episodes=5, trials=1)
+    run_learning(tmp_path / "short", short, client)
+    run_learning(tmp_path / "long", long_, client)
+    assert replay_run(tmp_path / "long", tmp_path / "replayed", short)
+    assert (tmp_path / "replayed" / "trials" / "trial_0.json").read_bytes() == \
+        (tmp_path / "short" / "trials" / "trial_0.json").read_bytes()
+    assert not replay_run(tmp_path / "long", tmp_path / "other", {**short, "seed": 4})
+    assert not replay_run(tmp_path / "long", tmp_path / "more", _settings(episodes=6, trials=1))
+    assert not (tmp_path / "other").exists() and not (tmp_path / "more").exists()
+    forged = json.loads((tmp_path / "long" / "trials" / "trial_0.json").read_text())
+    forged["episodes"][1]["t1"] += 0.01
+    (tmp_path / "long" / "trials" / "trial_0.json").write_text(json.dumps(forged))
+    with pytest.raises(ParameterError, match="episode 2: the learner draws"):
+        replay_run(tmp_path / "long", tmp_path / "forged", short)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("learner", ["cmaes", "pgpe"])
 def test_every_learner_resumes_to_the_uninterrupted_result(tmp_path, learner):
@@ -161,10 +182,19 @@ def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client)
     config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     window_map.run(window_map.WindowMapSettings(config, t1_max_s=0.1, t2_max_s=0.3), tmp_path / "map", client,
                    progress=False)
+    from drake_biped.experiments import learning
+
+    longer = learning.run(learning.LearningSettings(config, trials=1, episodes=5), tmp_path / "learn", client,
+                          progress=False)
     settings = compare_learners.CompareSettings(config, str(tmp_path / "map"), learners=("garb", "cmaes"),
-                                                trials=1, episodes=3)
+                                                trials=1, episodes=3, reuse={"garb": str(tmp_path / "learn")})
     record = compare_learners.run(settings, tmp_path / "cmp", client, progress=False)
     assert set(record["learners"]) == {"garb", "cmaes"}
+    # GARB's run is the longer run's first three episodes, replayed; CMA-ES has none to reuse and walks.
+    assert record["learners"]["garb"]["replayed_from"] == str(tmp_path / "learn")
+    assert record["learners"]["cmaes"]["replayed_from"] is None
+    garb = json.loads((tmp_path / "cmp" / "garb" / "learning.json").read_text())
+    assert garb["trials"][0]["episodes"] == longer["trials"][0]["episodes"][:3]
     for name, row in record["learners"].items():
         learned = json.loads((tmp_path / "cmp" / name / "learning.json").read_text())
         assert row["episodes"] == 3 and row["trials"] == 1

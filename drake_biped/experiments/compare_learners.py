@@ -4,13 +4,15 @@ each learner's final windows re-walked with the plant step halved and from a nud
 (`drake_biped.experiments.rewalk`).
 
 Each learner's run is an ordinary learning run in OUT/NAME/ (the same records, figures and resume as
-`drake-biped learn --learner NAME`); OUT/compare.json, compare.md and compare.png put them side by side
+`drake-biped learn --learner NAME`); a learner given in `reuse` with a longer run of the same settings (the
+paper's GARB run of `learn`, say) takes that run's first episodes (`learning.replay_run`) instead of walking
+them again; OUT/compare.json, compare.md and compare.png put them side by side
 (`drake_biped.analysis.learner_comparison`). Rerunning the same command resumes every unfinished run.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +38,7 @@ class CompareSettings:
     seed: int = 0
     mean: tuple[float, float] = GARB_MEAN_S
     variance: float = GARB_VARIANCE_S2
+    reuse: dict[str, str] = field(default_factory=dict)  # learner name: folder of a longer run to replay
 
     def map_path(self) -> Path:
         source = Path(self.window_map)
@@ -91,9 +94,12 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
     rows, curves = {}, {}
     with client_or_local(client) as c:
         for name in settings.learners:
-            record = learning.run(_learning_settings(settings, name), out / name, c, progress=progress)
+            learn_settings = _learning_settings(settings, name).record()
+            source = settings.reuse.get(name)
+            replayed = source is not None and learning.replay_run(Path(source), out / name, learn_settings)
+            record = learning.run(learn_settings, out / name, c, progress=progress)
             wall = read_json(out / name / "run.json", "compare-learners")["learning_wall_s"]
-            rows[name] = {**compare(record, best), "wall_s": wall}
+            rows[name] = {**compare(record, best), "wall_s": wall, "replayed_from": source if replayed else None}
             curves[name] = [t["episodes"] for t in record["trials"]]
     record = {
         "settings": {"learners": list(settings.learners), "trials": settings.trials, "episodes": settings.episodes,
@@ -123,6 +129,12 @@ def _rewalked(row: dict[str, Any]) -> str:
             f"({row['rewalked_holding']}/{row['trials']})")
 
 
+def _wall(row: dict[str, Any]) -> str:
+    if row.get("replayed_from"):
+        return f"replayed from {row['replayed_from']}"
+    return f"{row['wall_s'] / 60:.1f}"
+
+
 def markdown(record: dict[str, Any]) -> str:
     best = record["best_window"]
     s = record["settings"]
@@ -138,7 +150,7 @@ def markdown(record: dict[str, Any]) -> str:
         lines.append(f"| {name} | {_cell(r['final_cost_of_transport'], '.4f')} | "
                      f"{_cell(None if r['reduction'] is None else 100 * r['reduction'], '+.1f')} % | "
                      f"{_rewalked(r)} | {r['learned_walks']}/{r['trials']} | {_cell(r['mean_distance_to_best_s'], '.3f')} | "
-                     f"{r['reached']}/{r['trials']} ({reach}) | {r['falls']}/{r['episodes']} | {r['wall_s'] / 60:.1f} |")
+                     f"{r['reached']}/{r['trials']} ({reach}) | {r['falls']}/{r['episodes']} | {_wall(r)} |")
     return "\n".join(lines) + "\n"
 
 

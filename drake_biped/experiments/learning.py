@@ -154,11 +154,28 @@ class Trial:
             "steps": len(result["steps"]),
         }
         self.episodes.append(row)
+        self._write()
+        return row
+
+    def replay(self, episodes: list[dict[str, Any]]) -> None:
+        """Take the first episodes of another run of this trial's learner, seed and configuration (a longer run
+        of the same fixed settings): the learner draws each sample again, which must be the recorded one, and
+        is told the recorded reward; no episode is walked. The record is written once, at the end."""
+        for e in episodes:
+            sample = self.learner.ask()
+            if (float(sample[0]), float(sample[1])) != (e["t1"], e["t2"]):
+                raise ParameterError(f"trial {self.index}, episode {e['episode']}: the learner draws "
+                                     f"({sample[0]!r}, {sample[1]!r}), the record holds ({e['t1']!r}, {e['t2']!r}); "
+                                     "the record was not made by this learner and seed")
+            self.learner.tell(sample, e["reward"])
+            self.episodes.append(e)
+        self._write()
+
+    def _write(self) -> None:
         write_atomic(self.path, {"record_version": RECORD_VERSION, "trial": self.index,
                                  "learner_seed": trial_seed(self.settings["seed"], self.index),
                                  "settings": self.settings, "episodes": self.episodes,
                                  "learner": self.learner.state()})
-        return row
 
 
 def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
@@ -233,6 +250,28 @@ def best_learned_trial(record: dict[str, Any], source: str = "learning.json") ->
         raise ParameterError(f"{source}: no trial learned a torque-free period that walks "
                              "(every final mean has t2 <= t1)")
     return min(rows, key=lambda r: float(r["cost_of_transport"]))
+
+
+def replay_run(source: Path, out: Path, settings: dict[str, Any]) -> bool:
+    """Write into `out` the trial records of the run `settings` from a run in `source` with the same fixed
+    settings and at least as many trials and episodes: each trial's first settings["episodes"] episodes, its
+    learner replayed through them (`Trial.replay`), exactly the records the run itself would write, without
+    walking an episode. Trials `out` already holds are kept. False, writing nothing, when `source` cannot give
+    them."""
+    records = []
+    for k in range(settings["trials"]):
+        path = Path(source) / "trials" / f"trial_{k}.json"
+        record = read_json(path, "trial record") if path.is_file() else None
+        if record is None or _fixed(record.get("settings", {})) != _fixed(settings) \
+                or len(record.get("episodes", [])) < settings["episodes"]:
+            return False
+        records.append(record)
+    (Path(out) / "trials").mkdir(parents=True, exist_ok=True)
+    for k, record in enumerate(records):
+        trial = Trial(Path(out), k, settings)
+        if not trial.done:
+            trial.replay(record["episodes"][:settings["episodes"]])
+    return True
 
 
 def run_learning(

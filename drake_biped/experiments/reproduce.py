@@ -229,8 +229,9 @@ class Reproduction:
         from drake_biped.experiments import compare_learners
 
         trials, episodes = self.profile.compare
+        # GARB with the paper's settings is `learn`'s run: its first episodes are replayed, not walked again.
         settings = compare_learners.CompareSettings(self.level, str(self.out / "window_map"), trials=trials,
-                                                    episodes=episodes)
+                                                    episodes=episodes, reuse={"garb": str(self.out / "learn")})
 
         def run(folder: Path) -> dict:
             record = compare_learners.run(settings, folder, self._client, progress=False)
