@@ -115,6 +115,9 @@ def test_slope_story_on_a_short_setting(tmp_path):
     assert checks["no_window"]["climbs"] and checks["no_window"]["distance_m"] >= 4.0
     assert not checks["start_window"]["climbs"] and 2.0 < checks["start_window"]["distance_m"] < 4.0
     assert record["verdicts"]["learned_period_fails_to_climb"] and record["verdicts"]["no_period_climbs"]
+    # ... in each of its four walks: as learned, at half the plant step, from 0.95 and 1.05 x the speed.
+    assert record["rewalks"]["no_window"]["all_climb"] and record["rewalks"]["start_window"]["none_climbs"]
+    assert (tmp_path / "climbing" / "checks" / "no_window.half_step.json").is_file()
     assert not default["checks"]["no_window"]["climbs"]  # the default gait falls on the slope
     assert len(record["episodes"][0]["episodes"]) == 2
     assert again["checks"] == record["checks"] and again["trials"] == record["trials"]

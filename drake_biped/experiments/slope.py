@@ -163,16 +163,17 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
                **trial_summary(t.episodes, config.sim.distance_m),
                "final_policy": _summary(final["as_learned"]), "final_policy_rewalks": _rewalks(final)}
         trial_rows.append(row)
+    rewalks = {name: _rewalks(r) for name, r in checks.items()}
     record = {
         "settings": settings,
         "ground": ground.to_dict(),
         "start": {**start_source, "mean": start.mean.tolist(), "period_s": start_period,
                   "variance": start.variance},
         "checks": {name: _summary(r["as_learned"]) for name, r in checks.items()},
-        "rewalks": {name: _rewalks(r) for name, r in checks.items()},
+        "rewalks": rewalks,
         "trials": trial_rows,
         "episodes": [{"trial": t.index, "episodes": t.episodes} for t in runs],
-        "verdicts": verdicts({name: _rewalks(r) for name, r in checks.items()}, trial_rows, start_period),
+        "verdicts": verdicts(rewalks, trial_rows, start_period),
         "versions": code,
     }
     write_atomic(out / "slope.json", record)
