@@ -359,8 +359,7 @@ def cmd_floquet(args: argparse.Namespace) -> int:
 
 def cmd_rewalk(args: argparse.Namespace) -> int:
     from drake_biped.analysis.rewalks import markdown
-    from drake_biped.experiments.learning import check_learning_record
-    from drake_biped.experiments.rewalk import rewalk_record
+    from drake_biped.experiments.learning import check_learning_record, rewalk_record
     from drake_biped.records import read_json, write_atomic, write_text_atomic
 
     # What is not a learning record is refused before a cluster starts.

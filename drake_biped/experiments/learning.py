@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.reward import reward
+from drake_biped.experiments.rewalk import rewalk, window_of
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.registry import learner_from_state, make_learner
 from drake_biped.paper import (
@@ -57,11 +58,6 @@ RECORD_VERSION = 1
 def trial_seed(seed: int, trial: int) -> int:
     """The learner seed of trial `trial` in a run seeded `seed` (independent streams per trial)."""
     return int(np.random.SeedSequence([seed, trial]).generate_state(1)[0])
-
-
-def window_of(sample: np.ndarray) -> TorqueFreeWindow:
-    t1, t2 = (max(0.0, min(float(x), 10.0)) for x in sample)
-    return TorqueFreeWindow(t1, t2)
 
 
 def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
@@ -326,8 +322,6 @@ def evaluate(settings: dict[str, Any], trials: list[Trial], client) -> dict[str,
     """Table V's measured rows: the gait without a window, and with each trial's final policy mean; and every
     one of them re-walked with the plant step halved and from 0.95 and 1.05 x the initiation speed
     (`drake_biped.experiments.rewalk`), as "rewalks"."""
-    from drake_biped.experiments.rewalk import rewalk
-
     base = EpisodeConfig.from_dict(settings["config"])
     means = [{"trial": t.index, "t1": float(t.learner.mean[0]), "t2": float(t.learner.mean[1])} for t in trials]
     rewalks = rewalk(base, means, client)
@@ -443,3 +437,17 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
                      f"{len(run_log['sessions'])} session(s)")
     lines.append(f"wrote {out}/learning.json, fig4_reward.png, fig5_cmt.png, fig6_times.png, table_v.md")
     return lines
+
+
+def rewalk_record(source: Path, client) -> dict[str, Any]:
+    """The re-walks of a learning record's final policy means (`source`: a learning.json), with what they
+    were made from."""
+    record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
+    try:
+        config = EpisodeConfig.from_dict(record["settings"]["config"])
+        learned = [{"trial": int(t["trial"]), "t1": float(t["final_mean"][0]), "t2": float(t["final_mean"][1])}
+                   for t in record["trials"]]
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise ParameterError(f"--policy {source}: a learning record without its final means ({exc})") from None
+    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client),
+            "versions": versions()}

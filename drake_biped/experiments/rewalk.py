@@ -9,13 +9,18 @@ for any learning record. What a saving, a trial's figure and holding mean: `drak
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.rewalks import CHANGES, KEEP, summary
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
 
-__all__ = ["changed", "rewalk", "rewalk_record"]
+__all__ = ["changed", "rewalk", "window_of"]
+
+
+def window_of(sample) -> TorqueFreeWindow:
+    """The window a learner's sample (t1, t2) walks: times below 0 act as 0, above 10 s as 10 s."""
+    t1, t2 = (max(0.0, min(float(x), 10.0)) for x in sample)
+    return TorqueFreeWindow(t1, t2)
 
 
 def changed(config: EpisodeConfig, change: str) -> EpisodeConfig:
@@ -34,7 +39,6 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client) -> dict
     """Walk each learned window (`learned`: {"trial", "t1", "t2"}, a policy mean, per trial) and the gait
     without a window, as learned and under each change, on the Dask `client`: the `summary` record."""
     from drake_biped.experiments.executor import episode_task
-    from drake_biped.experiments.learning import window_of
 
     plain = config.replace(window=TorqueFreeWindow())
     jobs: dict[tuple[str, Any], dict[str, Any]] = {}
@@ -54,21 +58,3 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client) -> dict
         for t in learned:
             rows[change].setdefault(t["trial"], rows[change]["no_window"])
     return summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows)
-
-
-def rewalk_record(source: Path, client) -> dict[str, Any]:
-    """The re-walks of a learning record's final policy means (`source`: a learning.json), with what they
-    were made from."""
-    from drake_biped.experiments.learning import check_learning_record
-    from drake_biped.records import read_json
-    from drake_biped.versions import versions
-
-    record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
-    try:
-        config = EpisodeConfig.from_dict(record["settings"]["config"])
-        learned = [{"trial": int(t["trial"]), "t1": float(t["final_mean"][0]), "t2": float(t["final_mean"][1])}
-                   for t in record["trials"]]
-    except (KeyError, TypeError, ValueError, IndexError) as exc:
-        raise ParameterError(f"--policy {source}: a learning record without its final means ({exc})") from None
-    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client),
-            "versions": versions()}
