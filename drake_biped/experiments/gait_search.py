@@ -42,7 +42,18 @@ walks, by the objective:
   objective with every draw's reward gain taken as the smaller of its gains at the step and at half the step
   (each against no window at that step), the best draw's gain as the smallest of that and its gains from the
   initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG's
-  distance from Table III (a tie-breaker towards the paper); from -1.01 up.
+  distance from Table III (a tie-breaker towards the paper); from -1.01 up;
+- "hold": the "robust" objective first, then whether every window the paper's learner may end on holds: the hip
+  off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows'
+  t2 lie past the step's end, so the saving is a curve in t1), each walked as it is, at half the plant step and
+  from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies
+  past the powered step's end acts only when a step runs long, and once it acts the step runs long: two gaits,
+  chosen by the walk's details, that save much in one walk and little in the next. The learner's reach is every
+  window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window's (GARB's reward
+  is flat there, and a walk that falls into the long step pays it more); the score is the smallest C_mt saving
+  over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus
+  0.1 x the mean over HOLD_WINDOWS of each window's smallest reward gain (a wider slope that holds), minus
+  0.01 d / (1 + d) as in "story".
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
@@ -128,12 +139,17 @@ COAST_MUTATIONS = {
 }
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
                  "coast": COAST_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape", "robust", "story")
+OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape", "robust", "story",
+              "hold")
 # The "robust" objective's changes to the walk without a window, and the half step's allowed C_mt change.
 ROBUST_CHECKS = ("half_step", "speed_0.95", "speed_1.05", "push_forward", "push_backward")
 ROBUST_CMT_CHANGE = 0.02
 # Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
 COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
+# The "hold" objective's windows (t1 across the end of the step, t2 past any step) and how far below the best
+# window's reward gain a window still lies within the learner's reach.
+HOLD_WINDOWS = tuple((round(0.30 + 0.02 * i, 2), 1.2) for i in range(14))
+HOLD_PLATEAU = 0.05
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -300,6 +316,39 @@ def _story_score(config: EpisodeConfig, base: dict[str, Any], draws: int) -> tup
                    "distance_from_table_iii": d}
 
 
+def _saving(row: dict[str, Any], base: dict[str, Any]) -> float:
+    """C_mt saving of a walk with a window against `base` without one; -1 when either falls."""
+    if not (row["walked"] and base["walked"]):
+        return -1.0
+    return 1.0 - row["cost_of_transport"] / base["cost_of_transport"]
+
+
+def _hold_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold" objective (module docstring) and what it measured; `base` may be a fall."""
+    robust, detail = _robust_score(config, base)
+    if robust < 0.0:
+        return robust - 2.0, detail
+    bases = {"as_is": base, **{k: detail["checks"][k] for k in ("half_step", "speed_0.95", "speed_1.05")}}
+    changed = {"as_is": config,
+               "half_step": config.override({"sim.time_step_s": 0.5 * config.sim.time_step_s}),
+               "speed_0.95": config.override({"initial.speed_mps": 0.95 * config.initial.speed_mps}),
+               "speed_1.05": config.override({"initial.speed_mps": 1.05 * config.initial.speed_mps})}
+    windows = []
+    for t1, t2 in HOLD_WINDOWS:
+        walks = {name: _walk(c.replace(window=TorqueFreeWindow(t1, t2))) for name, c in changed.items()}
+        gains = {name: w["reward"] / bases[name]["reward"] - 1.0 for name, w in walks.items()}
+        windows.append({"window": [t1, t2], "walks": walks, "gains": gains,
+                        "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
+    top = max(max(w["gains"].values()) for w in windows)
+    reach = [w for w in windows if max(w["gains"].values()) >= top - HOLD_PLATEAU]
+    least = min(min(w["savings"].values()) for w in reach)
+    d = distance_from_table_iii(config.cpg)
+    slope = sum(min(w["gains"].values()) for w in windows) / len(windows)
+    value = least + 0.1 * slope - 0.01 * d / (1.0 + d)
+    return value, {**detail, "windows": windows, "reach": [w["window"] for w in reach], "least_saving": least,
+                   "distance_from_table_iii": d}
+
+
 def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows",
           draws: int = POLICY_DRAWS) -> tuple[float, dict[str, Any]]:
     """The search objective (module docstring) and what it measured; `draws`: how many draws of the start
@@ -309,6 +358,8 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         return _robust_score(config, base)
     if objective == "story":
         return _story_score(config, base, draws)
+    if objective == "hold":
+        return _hold_score(config, base)
     if not base["walked"]:
         return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
             {"baseline": base, "windows": []}
