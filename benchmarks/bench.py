@@ -111,6 +111,27 @@ def replay(config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, durati
     return time.perf_counter() - t, plant.GetPositions(plant_context)
 
 
+def replay_directly(config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, duration: float) -> tuple[float, np.ndarray]:
+    """Wall time of the plant alone over `duration`, stepped by a Python loop (its forced update, as
+    episode._step_directly steps it) instead of the Simulator, and its final positions: the floor of the
+    directly stepped closed loop."""
+    diagram, plant = build_replay_diagram(config, times, torques)
+    root = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(root)
+    q0, v0, _, _ = initial_state(config)
+    plant.SetPositions(plant_context, q0)
+    plant.SetVelocities(plant_context, v0)
+    h = config.sim.time_step_s
+    step, set_time = plant.ExecuteForcedEvents, root.SetTime
+    k = 0
+    t = time.perf_counter()
+    while k * h < duration:
+        set_time(k * h)
+        step(plant_context, False)
+        k += 1
+    return time.perf_counter() - t, plant.GetPositions(plant_context)
+
+
 def real_time_factors(steps: list[float], distance: float, repeats: int) -> dict:
     """Plant alone vs closed loop at each time step, interleaved, `repeats` rounds."""
     logged = {}

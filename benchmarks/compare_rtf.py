@@ -8,8 +8,10 @@ Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) 
 `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
 Simulator.AdvanceTo; the first walk of a process also builds its diagram, which is not timed) and its C_mt.
 In the same round, a process of the after tree measures the ceiling on the same walk: the plant alone
-replaying the walk's logged torques (no Python during the simulation), and the plant with an empty Python
-discrete update at the control rate (the cost of calling Python at all). Rounds alternate the trees, so a
+replaying the walk's logged torques (no Python during the simulation), the same plant stepped by a Python
+loop instead of the Simulator (the floor of an episode that steps the plant itself, episode._step_directly),
+and the plant with an empty Python discrete update at the control rate (the cost of a Python system in the
+Simulator's loop). Rounds alternate the trees, so a
 change of machine load affects all of them alike; the table gives medians and the ratios.
 `--learning N` also times N episodes as a learning run starts them (benchmarks/bench.py learning_mix) on a
 2-worker Dask cluster, once per tree per round: episodes per minute.
@@ -46,9 +48,10 @@ config = bench.config_at(1e-3, {distance})
 ref = run_episode(config, record_trajectory=True)
 times, torques = ref.trajectory["time"], ref.trajectory["actuation"]
 end = float(times[-1])
-out = {{"plant": [], "empty": []}}
+out = {{"plant": [], "direct": [], "empty": []}}
 for _ in range({episodes}):
     out["plant"].append(end / bench.replay(config, times, torques, end)[0])
+    out["direct"].append(end / bench.replay_directly(config, times, torques, end)[0])
     out["empty"].append(end / bench.replay(config, times, torques, end, bench.EmptyUpdate(1e-3))[0])
 print(json.dumps(out))
 """
@@ -83,7 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     trees = {"before": args.before.resolve(), "after": args.after.resolve()}
     rtf: dict[str, list[float]] = {"before": [], "after": []}
     cmt: dict[str, list[float]] = {"before": [], "after": []}
-    ceiling: dict[str, list[float]] = {"plant": [], "empty": []}
+    ceiling: dict[str, list[float]] = {"plant": [], "direct": [], "empty": []}
     learning: dict[str, list[float]] = {"before": [], "after": []}
     closed = CLOSED_LOOP.format(episodes=args.episodes, distance=args.distance)
     for r in range(args.rounds):
@@ -114,6 +117,8 @@ def main(argv: list[str] | None = None) -> int:
         "| what | samples | median real-time factor | of the plant alone |",
         "|---|---|---|---|",
         f"| plant alone, replaying the walk's torques | {len(ceiling['plant'])} | {med['plant']:.3f} | 1.00 |",
+        f"| plant alone, stepped by a Python loop (no Simulator) | {len(ceiling['direct'])} | {med['direct']:.3f} | "
+        f"{med['direct'] / med['plant']:.2f} |",
         f"| plant + an empty Python update at 1 kHz | {len(ceiling['empty'])} | {med['empty']:.3f} | "
         f"{med['empty'] / med['plant']:.2f} |",
         f"| closed loop, before ({args.before}) | {len(rtf['before'])} | {med['before']:.3f} | "

@@ -35,7 +35,9 @@ tests/test_hot_path.py and tests/test_gait.py pin this down.
 
 The update's arithmetic is one compiled kernel (`control_step`, numba): Python only hands it the plant state,
 the update's own state vector (written in place) and the episode's numbers packed once per episode (`LAW`,
-`law_vector`), and turns its return code into the touchdown row and the EventStatus.
+`law_vector`), and turns its return code into the touchdown row and the EventStatus. An episode that records
+nothing calls the kernel itself between the plant's steps, on this system's state in the same context
+(episode._step_directly), with the same numbers.
 """
 
 from __future__ import annotations
@@ -577,6 +579,17 @@ class CpgWalkingController(LeafSystem):
     @property
     def state_group(self) -> int:
         return int(self._state_group)
+
+    @property
+    def touchdown_group(self) -> int:
+        """The discrete group of the recorded touchdowns (capacity x TOUCHDOWN rows)."""
+        return int(self._touchdown_group)
+
+    def kernel_arguments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """What `control_step` takes besides the time, the plant state and the state vectors, for a caller
+        that steps the plant itself (episode._step_directly): the episode's law vector, the body, the
+        touchdown row it fills and how many touchdown rows the touchdown group holds."""
+        return self._law, self._body, self._row, self._capacity
 
     @property
     def torque_group(self) -> int:

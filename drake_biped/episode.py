@@ -210,9 +210,11 @@ def simulate(
 
     The diagram comes from `cache` when one of the same structure was built before (never with Meshcat;
     cache=None always builds a new one); its context is reset to the defaults and this episode's numbers
-    and initial state. The controller ends the episode itself (a fall, or the distance walked); the
-    Simulator runs no Python between control updates unless `progress` asks for reports (every 0.25
-    simulated s). Reasons: "distance", "fall", "time limit", "diverged" (the control loop: see
+    and initial state. The controller ends the episode itself (a fall, or the distance walked). An episode
+    that records nothing and draws nothing steps the plant directly, the controller's compiled update between
+    its steps (`_step_directly`: the Simulator's numbers to the last bit, at a lower cost per step); one that
+    records or draws runs under the Simulator, the controller a Drake system in the diagram. `progress`
+    is called every 0.25 simulated s with the time and the distance walked. Reasons: "distance", "fall", "time limit", "diverged" (the control loop: see
     controller.REVERSAL_FACTOR), or "simulation failed: ..." (a diverging contact solve).
     """
     if meshcat is None and cache is not None:
@@ -221,6 +223,14 @@ def simulate(
         parts = build_diagram(config, meshcat=meshcat, record=record, log_period_s=log_period_s)
         simulator = Simulator(parts.diagram)
     plant_ctx, ctrl_ctx, com_x0 = reset_context(parts, simulator, config)
+    if not record and meshcat is None and _DIRECT_STEPS:
+        wall0 = time.perf_counter()
+        try:
+            _step_directly(parts, simulator.get_mutable_context(), config, progress, kick, com_x0)
+            reason = _reason(parts.controller.state(ctrl_ctx))
+        except RuntimeError as exc:  # a diverging contact solve: the episode is a fall, not a crash
+            reason = f"simulation failed: {exc}".splitlines()[0]
+        return parts, simulator, reason, time.perf_counter() - wall0
     group = parts.controller.state_group
     if progress is not None:
         next_report = [0.0]
@@ -249,15 +259,87 @@ def simulate(
                 parts.plant.SetPositions(plant_ctx, q)
                 parts.plant.SetVelocities(plant_ctx, v)
         simulator.AdvanceTo(config.sim.max_time_s)
-        s = parts.controller.state(ctrl_ctx)
-        if s.fall_code == ctl.DIVERGED_CODE:
-            reason = "diverged"
-        else:
-            reason = "fall" if s.fall_code != 0.0 else ("distance" if s.done else "time limit")
+        reason = _reason(parts.controller.state(ctrl_ctx))
     except RuntimeError as exc:  # a diverging contact solve: the episode is a fall, not a crash
         reason = f"simulation failed: {exc}".splitlines()[0]
     wall = time.perf_counter() - wall0
     return parts, simulator, reason, wall
+
+
+def _reason(s) -> str:
+    """Why an episode ended, from the controller's state at its end."""
+    if s.fall_code == ctl.DIVERGED_CODE:
+        return "diverged"
+    return "fall" if s.fall_code != 0.0 else ("distance" if s.done else "time limit")
+
+
+# Whether `simulate` steps the plant itself when it records nothing (see _step_directly); the Simulator path
+# stays for recording, Meshcat and comparison (tests/test_hot_path.py).
+_DIRECT_STEPS = True
+
+
+def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, kick: Kick | None,
+                   com_x0: float) -> None:
+    """The episode of simulate() without the Simulator: the plant's discrete step (its forced update, the
+    one its periodic event runs) called in a loop, and the controller's compiled update called with the
+    state that step produced at every control period, exactly as the Simulator orders the two events that
+    fall at the same time (the controller reads the plant's sampled output: the state the step makes; the
+    step acts with the torques held before). The same numbers as the Simulator path to the last bit
+    (tests/test_hot_path.py), without the Simulator's event dispatch and the Python callback it makes every
+    control period, which cost about as much as the plant's own step."""
+    plant, controller = parts.plant, parts.controller
+    plant_ctx = plant.GetMyMutableContextFromRoot(root)
+    ctrl_ctx = controller.GetMyMutableContextFromRoot(root)
+    h = config.sim.time_step_s
+    every = int(round(config.sim.control_period_s / h))
+    x = plant_ctx.get_discrete_state(0).get_value()
+    s = ctrl_ctx.get_mutable_discrete_state(controller.state_group).get_mutable_value()
+    tau = ctrl_ctx.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
+    touchdowns = ctrl_ctx.get_mutable_discrete_state(controller.touchdown_group).get_mutable_value()
+    law, body, row, capacity = controller.kernel_arguments()
+    width = ctl.TOUCHDOWN.size
+    torques = controller.torque_group
+    step = plant.ExecuteForcedEvents
+    set_time, mutable = root.SetTime, ctrl_ctx.get_mutable_discrete_state
+    pushed = config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0
+    end = config.sim.max_time_s
+    next_report = 0.0
+    k = 0
+    kick_time = kick.time_s if kick is not None and kick.time_s < end else None
+    while True:
+        t = k * h
+        if kick_time is not None and t >= kick_time:
+            kick_time = None
+            if s[ctl.FALL] == 0.0 and s[ctl.DONE] == 0.0:
+                i = 3 + joint_index("left" if s[ctl.STANCE_RIGHT] > 0.5 else "right", "hip")  # the swing hip
+                q = plant.GetPositions(plant_ctx).copy()
+                v = plant.GetVelocities(plant_ctx).copy()
+                q[i] += kick.hip_angle_rad
+                v[i] += kick.hip_rate_radps
+                plant.SetPositions(plant_ctx, q)
+                plant.SetVelocities(plant_ctx, v)
+                x = plant_ctx.get_discrete_state(0).get_value()
+        if t >= end:
+            break
+        if pushed:
+            set_time(t)
+        step(plant_ctx, False)
+        if k % every == 0:
+            code = ctl.control_step(law, body, t, x, s, tau, row)
+            mutable(torques)  # the held torques changed: what reads them is out of date
+            if code:
+                if code & ctl.TOUCHED:
+                    n = int(row[0])
+                    if n < capacity:
+                        touchdowns[n * width : (n + 1) * width] = row[1:]
+                if code & (ctl.FELL | ctl.DONE_BIT):
+                    break
+        k += 1
+        if progress is not None and k * h >= next_report:
+            next_report += 0.25
+            progress(k * h, s[ctl.COM_X] - com_x0)
+    set_time(k * h)
+    ctrl_ctx.get_mutable_discrete_state()  # every group was written in place
 
 
 def run_episode(

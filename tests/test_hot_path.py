@@ -8,7 +8,7 @@ from drake_biped import controller as ctl
 from drake_biped.diagram import build_diagram, build_replay_diagram, initial_state
 from drake_biped.episode import DiagramCache, run_episode
 from drake_biped.kinematics import center_of_mass
-from drake_biped.params import EpisodeConfig, Ground, InitialConditions, SimulationParams, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, Ground, InitialConditions, Push, SimulationParams, TorqueFreeWindow
 
 
 def _config():
@@ -186,3 +186,32 @@ def test_the_compiled_update_gives_the_numbers_of_the_same_code_run_as_python():
     assert len(compiled.steps) >= 2
     assert interpreted == [compiled.positive_work_j["total"], compiled.distance_m,
                            [s.hip_rate_radps for s in compiled.steps]]
+
+
+@pytest.mark.parametrize("change, ending", [
+    ({"window": TorqueFreeWindow(0.2, 0.5)}, "distance"),
+    ({"sim": SimulationParams(distance_m=1.5, max_time_s=15.0, time_step_s=5e-4)}, "distance"),  # 2 steps a period
+    ({"push": Push(-60.0)}, "fall"),
+    ({"sim": SimulationParams(distance_m=1.5, max_time_s=0.8345)}, "time limit"),
+])
+def test_stepping_the_plant_directly_gives_the_simulators_numbers(monkeypatch, change, ending):
+    """The episode path that calls the plant's step itself (no Simulator, no Python callback) gives the
+    Simulator path's walk to the last bit: work, distance, duration, touchdowns, and why it ended; also with
+    a kick of the swing hip between two steps."""
+    from drake_biped import episode
+
+    config = EpisodeConfig(sim=SimulationParams(distance_m=1.5, max_time_s=15.0)).replace(**change)
+    kick = episode.Kick(0.6017, 0.01, 0.1)
+
+    def walks():
+        return [run_episode(config, cache=None), run_episode(config, cache=None, kick=kick)]
+
+    monkeypatch.setattr(episode, "_DIRECT_STEPS", False)
+    simulator = walks()
+    monkeypatch.setattr(episode, "_DIRECT_STEPS", True)
+    for a, b in zip(simulator, walks()):
+        assert (a.termination, a.fall_reason) == (b.termination, b.fall_reason)
+        assert a.positive_work_j == b.positive_work_j and a.signed_work_j == b.signed_work_j
+        assert (a.distance_m, a.duration_s) == (b.distance_m, b.duration_s)
+        assert [vars(s) for s in a.steps] == [vars(s) for s in b.steps]
+    assert simulator[0].termination == ending
