@@ -8,7 +8,14 @@ from drake_biped import controller as ctl
 from drake_biped.diagram import build_diagram, build_replay_diagram, initial_state
 from drake_biped.episode import DiagramCache, run_episode
 from drake_biped.kinematics import center_of_mass
-from drake_biped.params import EpisodeConfig, Ground, InitialConditions, Push, SimulationParams, TorqueFreeWindow
+from drake_biped.params import (
+    EpisodeConfig,
+    Ground,
+    InitialConditions,
+    Push,
+    SimulationParams,
+    TorqueFreeWindow,
+)
 
 
 def _config():
