@@ -304,33 +304,34 @@ def test_story_objective_judges_each_draw_where_it_saves_least(monkeypatch):
     assert value == pytest.approx((0.25 - 1.0) / 6.0 - 2.0)
 
 
-def _fake_edge_walk(edge_saving):
+def _fake_edge_walk(edge_saving, edge_half_step_saving):
     """A stand-in walk: no window costs 0.2; a window with t1 < 0.46 s saves 45 % in every walk, one with t1 >= 0.46 s
-    (past the powered step's end) saves `edge_saving` as it is and 10 % at half the plant step."""
+    (past the powered step's end) saves `edge_saving`, and `edge_half_step_saving` at half the plant step."""
     def walk(config):
         if not config.window.active:
             cmt = 0.2
         elif config.window.start_s < 0.46:
             cmt = 0.2 * 0.55
         else:
-            cmt = 0.2 * (0.9 if config.sim.time_step_s < 0.001 else 1.0 - edge_saving)
+            cmt = 0.2 * (1.0 - (edge_half_step_saving if config.sim.time_step_s < 0.001 else edge_saving))
         return {"walked": True, "cost_of_transport": cmt, "distance_m": 10.0, "reward": 1.0 / cmt}
     return walk
 
 
-def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatch):
-    """Windows past the step's end that save 50 % as they are (more than the 45 % of earlier ones) are where the
-    learner goes: the score is their 10 % at half the step; saving only 40 %, they are out of its reach, and the
-    score is the 45 % every earlier window holds in all four walks."""
+@pytest.mark.parametrize("edge, half, reach, least", [
+    (0.5, 0.1, (0.44, 0.56), 0.1),  # the edge saves most as it is: the learner goes there
+    (0.4, 0.4, (0.30, 0.46), 0.4),  # earlier windows save most; the edge next to them holds
+    (0.4, 0.1, (0.30, 0.46), 0.1),  # ... and does not: a trial that ends 0.02 s late loses the saving
+])
+def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatch, edge, half, reach, least):
+    """The learner's reach is the windows within 0.05 of the best reward gain in any of the four walks and those
+    0.02 s from them; the score is the smallest saving there, in any walk, plus a tenth of the mean smallest gain."""
     config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
+    monkeypatch.setattr(gait_search, "_walk", _fake_edge_walk(edge, half))
+    value, detail = gait_search.score(config, objective="hold")
+    t1s = [t1 for t1, _ in gait_search.HOLD_WINDOWS]
+    assert [t1 for t1, _ in detail["reach"]] == [t1 for t1 in t1s if reach[0] - 1e-9 <= t1 <= reach[1] + 1e-9]
+    assert detail["least_saving"] == pytest.approx(least)
+    gains = [1 / 0.55 - 1 if t1 < 0.46 else 1 / (1 - min(edge, half)) - 1 for t1 in t1s]
     d = gait_search.distance_from_table_iii(config.cpg)
-    monkeypatch.setattr(gait_search, "_walk", _fake_edge_walk(0.5))
-    value, detail = gait_search.score(config, objective="hold")
-    assert [w for w, _ in gait_search.HOLD_WINDOWS if w >= 0.46] == [t1 for t1, _ in detail["reach"]]
-    assert detail["least_saving"] == pytest.approx(0.1)
-    monkeypatch.setattr(gait_search, "_walk", _fake_edge_walk(0.4))
-    value, detail = gait_search.score(config, objective="hold")
-    assert all(t1 < 0.46 for t1, _ in detail["reach"]) and len(detail["reach"]) == 8
-    assert detail["least_saving"] == pytest.approx(0.45)
-    slope = (8 * (1 / 0.55 - 1) + 6 * (1 / 0.9 - 1)) / 14
-    assert value == pytest.approx(0.45 + 0.1 * slope - 0.01 * d / (1.0 + d))
+    assert value == pytest.approx(least + 0.1 * sum(gains) / len(gains) - 0.01 * d / (1.0 + d))

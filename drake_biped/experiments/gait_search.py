@@ -50,8 +50,9 @@ walks, by the objective:
   past the powered step's end acts only when a step runs long, and once it acts the step runs long: two gaits,
   chosen by the walk's details, that save much in one walk and little in the next. The learner's reach is every
   window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window's (GARB's reward
-  is flat there, and a walk that falls into the long step pays it more); the score is the smallest C_mt saving
-  over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus
+  is flat there, and a walk that falls into the long step pays it more), and every window within HOLD_MARGIN_S
+  of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the
+  smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus
   0.1 x the mean over HOLD_WINDOWS of each window's smallest reward gain (a wider slope that holds), minus
   0.01 d / (1 + d) as in "story".
 
@@ -149,7 +150,7 @@ COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 # The "hold" objective's windows (t1 across the end of the step, t2 past any step) and how far below the best
 # window's reward gain a window still lies within the learner's reach.
 HOLD_WINDOWS = tuple((round(0.30 + 0.02 * i, 2), 1.2) for i in range(14))
-HOLD_PLATEAU = 0.05
+HOLD_PLATEAU, HOLD_MARGIN_S = 0.05, 0.02
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -340,7 +341,8 @@ def _hold_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dic
         windows.append({"window": [t1, t2], "walks": walks, "gains": gains,
                         "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
     top = max(max(w["gains"].values()) for w in windows)
-    reach = [w for w in windows if max(w["gains"].values()) >= top - HOLD_PLATEAU]
+    plateau = [w["window"][0] for w in windows if max(w["gains"].values()) >= top - HOLD_PLATEAU]
+    reach = [w for w in windows if any(abs(w["window"][0] - t1) <= HOLD_MARGIN_S + 1e-9 for t1 in plateau)]
     least = min(min(w["savings"].values()) for w in reach)
     d = distance_from_table_iii(config.cpg)
     slope = sum(min(w["gains"].values()) for w in windows) / len(windows)
