@@ -585,11 +585,18 @@ class CpgWalkingController(LeafSystem):
         """The discrete group of the recorded touchdowns (capacity x TOUCHDOWN rows)."""
         return int(self._touchdown_group)
 
-    def kernel_arguments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    def kernel_arguments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What `control_step` takes besides the time, the plant state and the state vectors, for a caller
-        that steps the plant itself (episode._step_directly): the episode's law vector, the body, the
-        touchdown row it fills and how many touchdown rows the touchdown group holds."""
-        return self._law, self._body, self._row, self._capacity
+        that steps the plant itself (episode._step_directly): the episode's law vector, the body and the
+        touchdown row it fills."""
+        return self._law, self._body, self._row
+
+    def store_touchdown(self, touchdowns: np.ndarray) -> None:
+        """Write the touchdown row the kernel just filled (it returned TOUCHED) into the touchdown group's
+        values `touchdowns`, while there is room."""
+        n = int(self._row[0])
+        if n < self._capacity:
+            touchdowns[n * _TD : (n + 1) * _TD] = self._row[1:]
 
     @property
     def torque_group(self) -> int:
@@ -642,9 +649,7 @@ class CpgWalkingController(LeafSystem):
         if code == 0:
             return None
         if code & TOUCHED:
-            n = int(self._row[0])
-            if n < self._capacity:
-                discrete_state.get_mutable_value(self._touchdown_group)[n * _TD : (n + 1) * _TD] = self._row[1:]
+            self.store_touchdown(discrete_state.get_mutable_value(self._touchdown_group))
         if code & FELL:
             fall = int(discrete_state.get_value(self._state_group)[FALL])
             return EventStatus.ReachedTermination(self, FALL_REASONS[fall])

@@ -214,8 +214,8 @@ def simulate(
     that records nothing and draws nothing steps the plant directly, the controller's compiled update between
     its steps (`_step_directly`: the Simulator's numbers to the last bit, at a lower cost per step); one that
     records or draws runs under the Simulator, the controller a Drake system in the diagram. `progress`
-    is called every 0.25 simulated s with the time and the distance walked. Reasons: "distance", "fall", "time limit", "diverged" (the control loop: see
-    controller.REVERSAL_FACTOR), or "simulation failed: ..." (a diverging contact solve).
+    is called every 0.25 simulated s with the time and the distance walked. Reasons: "distance", "fall",
+    "time limit", "diverged" (the control loop: see controller.REVERSAL_FACTOR), or "simulation failed: ..." (a diverging contact solve).
     """
     if meshcat is None and cache is not None:
         parts, simulator = cache.get(config, record, log_period_s)
@@ -251,19 +251,24 @@ def simulate(
             simulator.AdvanceTo(kick.time_s)
             s = parts.controller.state(ctrl_ctx)
             if s.fall_code == 0.0 and s.done == 0.0:
-                i = 3 + joint_index("left" if s.stance_right > 0.5 else "right", "hip")  # the swing hip
-                q = parts.plant.GetPositions(plant_ctx).copy()
-                v = parts.plant.GetVelocities(plant_ctx).copy()
-                q[i] += kick.hip_angle_rad
-                v[i] += kick.hip_rate_radps
-                parts.plant.SetPositions(plant_ctx, q)
-                parts.plant.SetVelocities(plant_ctx, v)
+                _kick(parts.plant, plant_ctx, s.stance_right > 0.5, kick)
         simulator.AdvanceTo(config.sim.max_time_s)
         reason = _reason(parts.controller.state(ctrl_ctx))
     except RuntimeError as exc:  # a diverging contact solve: the episode is a fall, not a crash
         reason = f"simulation failed: {exc}".splitlines()[0]
     wall = time.perf_counter() - wall0
     return parts, simulator, reason, wall
+
+
+def _kick(plant, plant_ctx, stance_right: bool, kick: Kick) -> None:
+    """Add `kick` to the swing hip's angle and rate in the plant's state."""
+    i = 3 + joint_index("left" if stance_right else "right", "hip")  # the swing hip
+    q = plant.GetPositions(plant_ctx).copy()
+    v = plant.GetVelocities(plant_ctx).copy()
+    q[i] += kick.hip_angle_rad
+    v[i] += kick.hip_rate_radps
+    plant.SetPositions(plant_ctx, q)
+    plant.SetVelocities(plant_ctx, v)
 
 
 def _reason(s) -> str:
@@ -286,7 +291,8 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     fall at the same time (the controller reads the plant's sampled output: the state the step makes; the
     step acts with the torques held before). The same numbers as the Simulator path to the last bit
     (tests/test_hot_path.py), without the Simulator's event dispatch and the Python callback it makes every
-    control period, which cost about as much as the plant's own step."""
+    control period: the default walk at 0.91 of the plant's speed instead of 0.73 (docs/RESULTS.md, "The
+    plant stepped directly")."""
     plant, controller = parts.plant, parts.controller
     plant_ctx = plant.GetMyMutableContextFromRoot(root)
     ctrl_ctx = controller.GetMyMutableContextFromRoot(root)
@@ -296,8 +302,8 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     s = ctrl_ctx.get_mutable_discrete_state(controller.state_group).get_mutable_value()
     tau = ctrl_ctx.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
     touchdowns = ctrl_ctx.get_mutable_discrete_state(controller.touchdown_group).get_mutable_value()
-    law, body, row, capacity = controller.kernel_arguments()
-    width = ctl.TOUCHDOWN.size
+    law, body, row = controller.kernel_arguments()
+    store = controller.store_touchdown
     torques = controller.torque_group
     step = plant.ExecuteForcedEvents
     set_time, mutable = root.SetTime, ctrl_ctx.get_mutable_discrete_state
@@ -311,13 +317,7 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
         if kick_time is not None and t >= kick_time:
             kick_time = None
             if s[ctl.FALL] == 0.0 and s[ctl.DONE] == 0.0:
-                i = 3 + joint_index("left" if s[ctl.STANCE_RIGHT] > 0.5 else "right", "hip")  # the swing hip
-                q = plant.GetPositions(plant_ctx).copy()
-                v = plant.GetVelocities(plant_ctx).copy()
-                q[i] += kick.hip_angle_rad
-                v[i] += kick.hip_rate_radps
-                plant.SetPositions(plant_ctx, q)
-                plant.SetVelocities(plant_ctx, v)
+                _kick(plant, plant_ctx, s[ctl.STANCE_RIGHT] > 0.5, kick)
                 x = plant_ctx.get_discrete_state(0).get_value()
         if t >= end:
             break
@@ -329,9 +329,7 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
             mutable(torques)  # the held torques changed: what reads them is out of date
             if code:
                 if code & ctl.TOUCHED:
-                    n = int(row[0])
-                    if n < capacity:
-                        touchdowns[n * width : (n + 1) * width] = row[1:]
+                    store(touchdowns)
                 if code & (ctl.FELL | ctl.DONE_BIT):
                     break
         k += 1

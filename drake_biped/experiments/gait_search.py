@@ -271,13 +271,17 @@ def _landscape_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                    "landscape": {"start_gain": start_gain, "best_gain": best_gain, "best_mean": land["best_mean"]}}
 
 
+def _changed(config: EpisodeConfig) -> dict[str, EpisodeConfig]:
+    """`config` with the plant step halved and from 0.95 and 1.05 x the initiation speed."""
+    speed = config.initial.speed_mps
+    return {"half_step": config.override({"sim.time_step_s": 0.5 * config.sim.time_step_s}),
+            "speed_0.95": config.override({"initial.speed_mps": 0.95 * speed}),
+            "speed_1.05": config.override({"initial.speed_mps": 1.05 * speed})}
+
+
 def _robust_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
     """The "robust" objective (module docstring) and what it measured; `base` may be a fall."""
-    plain = config.replace(window=TorqueFreeWindow())
-    speed = config.initial.speed_mps
-    rows = {"half_step": _walk(plain.override({"sim.time_step_s": 0.5 * config.sim.time_step_s})),
-            "speed_0.95": _walk(plain.override({"initial.speed_mps": 0.95 * speed})),
-            "speed_1.05": _walk(plain.override({"initial.speed_mps": 1.05 * speed}))}
+    rows = {name: _walk(c) for name, c in _changed(config.replace(window=TorqueFreeWindow())).items()}
     forward, backward = _push_rows(config)
     rows["push_forward"], rows["push_backward"] = forward, backward
     distance = config.sim.distance_m
@@ -330,10 +334,7 @@ def _hold_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dic
     if robust < 0.0:
         return robust - 2.0, detail
     bases = {"as_is": base, **{k: detail["checks"][k] for k in ("half_step", "speed_0.95", "speed_1.05")}}
-    changed = {"as_is": config,
-               "half_step": config.override({"sim.time_step_s": 0.5 * config.sim.time_step_s}),
-               "speed_0.95": config.override({"initial.speed_mps": 0.95 * config.initial.speed_mps}),
-               "speed_1.05": config.override({"initial.speed_mps": 1.05 * config.initial.speed_mps})}
+    changed = {"as_is": config, **_changed(config)}
     windows = []
     for t1, t2 in HOLD_WINDOWS:
         walks = {name: _walk(c.replace(window=TorqueFreeWindow(t1, t2))) for name, c in changed.items()}
