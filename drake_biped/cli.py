@@ -649,8 +649,9 @@ def build_parser() -> argparse.ArgumentParser:
                              "draw judged at the step and half the step and the best draw from 0.95 and 1.05 x "
                              "the initiation speed), 'hold' ('robust' first, then the smallest C_mt saving, over the "
                              "walk as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, "
-                             "of every hip-off-until-touchdown window t1 0.30-0.56 s within the learner's reach and "
-                             "0.02 s around it)")
+                             "of every hip-off-until-touchdown window t1 0.30-0.56 s within the learner's reach (the "
+                             "best reward's plateau, and 0.36-0.48 s where GARB's means have ended) and 0.02 s "
+                             "around it)")
     search.add_argument("--policy-draws", type=_count, default=12,
                         help="draws of the paper's start policy the 'policy', 'expected' and 'story' objectives walk "
                              "(default 12; a draw with t2 <= t1 is no window and costs no episode)")

@@ -304,34 +304,42 @@ def test_story_objective_judges_each_draw_where_it_saves_least(monkeypatch):
     assert value == pytest.approx((0.25 - 1.0) / 6.0 - 2.0)
 
 
-def _fake_edge_walk(edge_saving, edge_half_step_saving):
-    """A stand-in walk: no window costs 0.2; a window with t1 < 0.46 s saves 45 % in every walk, one with t1 >= 0.46 s
-    (past the powered step's end) saves `edge_saving`, and `edge_half_step_saving` at half the plant step."""
+def _fake_edge_walk(edge_saving, edge_half_step_saving, edge_t1=0.46, fall_off=0.0):
+    """A stand-in walk: no window costs 0.2; a window with t1 < `edge_t1` saves 45 % less `fall_off` per second of
+    t1 past 0.30 s in every walk, one with t1 >= `edge_t1` (past the powered step's end) saves `edge_saving`, and
+    `edge_half_step_saving` at half the plant step."""
+    def saving(t1, half_step):
+        if t1 < edge_t1 - 1e-9:
+            return 0.45 - fall_off * (t1 - 0.30)
+        return edge_half_step_saving if half_step else edge_saving
+
     def walk(config):
-        if not config.window.active:
-            cmt = 0.2
-        elif config.window.start_s < 0.46:
-            cmt = 0.2 * 0.55
-        else:
-            cmt = 0.2 * (1.0 - (edge_half_step_saving if config.sim.time_step_s < 0.001 else edge_saving))
+        cmt = 0.2 * (1.0 - saving(config.window.start_s, config.sim.time_step_s < 0.001)) \
+            if config.window.active else 0.2
         return {"walked": True, "cost_of_transport": cmt, "distance_m": 10.0, "reward": 1.0 / cmt}
-    return walk
+    return walk, saving
 
 
-@pytest.mark.parametrize("edge, half, reach, least", [
-    (0.5, 0.1, (0.44, 0.56), 0.1),  # the edge saves most as it is: the learner goes there
-    (0.4, 0.4, (0.30, 0.46), 0.4),  # earlier windows save most; the edge next to them holds
-    (0.4, 0.1, (0.30, 0.46), 0.1),  # ... and does not: a trial that ends 0.02 s late loses the saving
+@pytest.mark.parametrize("edge, half, edge_t1, fall_off, reach, least", [
+    (0.5, 0.1, 0.46, 0.0, (0.34, 0.56), 0.1),  # the edge saves most as it is: the learner goes there
+    (0.4, 0.4, 0.46, 0.0, (0.30, 0.50), 0.4),  # earlier windows save most; the edge next to them holds
+    (0.4, 0.1, 0.46, 0.0, (0.30, 0.50), 0.1),  # ... and does not: a trial that ends 0.02 s late loses the saving
+    # The reward peaks at 0.30-0.32 s; 500 episodes from 0.5 s may stop anywhere in 0.36-0.48 s, next to the edge.
+    (0.4, 0.1, 0.50, 0.5, (0.30, 0.50), 0.1),
+    (0.4, 0.4, 0.50, 0.5, (0.30, 0.50), 0.36),
 ])
-def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatch, edge, half, reach, least):
-    """The learner's reach is the windows within 0.05 of the best reward gain in any of the four walks and those
-    0.02 s from them; the score is the smallest saving there, in any walk, plus a tenth of the mean smallest gain."""
+def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatch, edge, half, edge_t1, fall_off,
+                                                                       reach, least):
+    """The learner's reach is the windows within 0.05 of the best reward gain in any of the four walks, those with
+    t1 in 0.36-0.48 s, and those 0.02 s from either; the score is the smallest saving there, in any walk, plus a
+    tenth of the mean smallest gain."""
     config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
-    monkeypatch.setattr(gait_search, "_walk", _fake_edge_walk(edge, half))
+    walk, saving = _fake_edge_walk(edge, half, edge_t1, fall_off)
+    monkeypatch.setattr(gait_search, "_walk", walk)
     value, detail = gait_search.score(config, objective="hold")
     t1s = [t1 for t1, _ in gait_search.HOLD_WINDOWS]
     assert [t1 for t1, _ in detail["reach"]] == [t1 for t1 in t1s if reach[0] - 1e-9 <= t1 <= reach[1] + 1e-9]
     assert detail["least_saving"] == pytest.approx(least)
-    gains = [1 / 0.55 - 1 if t1 < 0.46 else 1 / (1 - min(edge, half)) - 1 for t1 in t1s]
+    gains = [1 / (1 - min(saving(t1, False), saving(t1, True))) - 1 for t1 in t1s]
     d = gait_search.distance_from_table_iii(config.cpg)
     assert value == pytest.approx(least + 0.1 * sum(gains) / len(gains) - 0.01 * d / (1.0 + d))

@@ -50,8 +50,10 @@ walks, by the objective:
   past the powered step's end acts only when a step runs long, and once it acts the step runs long: two gaits,
   chosen by the walk's details, that save much in one walk and little in the next. The learner's reach is every
   window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window's (GARB's reward
-  is flat there, and a walk that falls into the long step pays it more), and every window within HOLD_MARGIN_S
-  of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the
+  is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the
+  means of GARB with the paper's settings ended on the gaits it has been run on, whatever their reward's peak:
+  500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one
+  of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the
   smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus
   0.1 x the mean over HOLD_WINDOWS of each window's smallest reward gain (a wider slope that holds), minus
   0.01 d / (1 + d) as in "story".
@@ -151,6 +153,9 @@ COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 # window's reward gain a window still lies within the learner's reach.
 HOLD_WINDOWS = tuple((round(0.30 + 0.02 * i, 2), 1.2) for i in range(14))
 HOLD_PLATEAU, HOLD_MARGIN_S = 0.05, 0.02
+# t1 of the means GARB with the paper's settings ended on: 0.37-0.45 s on hold-g1 (reward peak 0.32 s) and
+# 0.41-0.47 s on cand1 (benchmarks/results/learn-*); 0.30-0.53 s on coasting_wide at 0.5 ms.
+HOLD_BAND = (0.36, 0.48)
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -342,7 +347,8 @@ def _hold_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dic
         windows.append({"window": [t1, t2], "walks": walks, "gains": gains,
                         "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
     top = max(max(w["gains"].values()) for w in windows)
-    plateau = [w["window"][0] for w in windows if max(w["gains"].values()) >= top - HOLD_PLATEAU]
+    plateau = [w["window"][0] for w in windows if max(w["gains"].values()) >= top - HOLD_PLATEAU
+               or HOLD_BAND[0] - 1e-9 <= w["window"][0] <= HOLD_BAND[1] + 1e-9]
     reach = [w for w in windows if any(abs(w["window"][0] - t1) <= HOLD_MARGIN_S + 1e-9 for t1 in plateau)]
     least = min(min(w["savings"].values()) for w in reach)
     d = distance_from_table_iii(config.cpg)
