@@ -1,6 +1,8 @@
 """The reproduction: its verdict rules, its report's assembly, and a whole run on the smallest settings."""
 
+import math
 import re
+from pathlib import Path
 
 import pytest
 
@@ -90,10 +92,10 @@ SMOKE = Profile("smoke", distance_m=5.0, grid_points=1, grid_initiation_points=1
                 floquet_newton_iterations=2)
 
 SECTIONS = ("## The walk", "## Grid search, Table IV", "## Table III as printed", "## Torque-free windows",
-            "## Experiment 1", "## Learners side by side",
-            "### Table V", "### Exploration matched", "## Pushes and return maps", "Table VI", "### Push margins", "### The periodic orbit and its Floquet multipliers",
-            "## The paper's learner on the gait searched for it", "## Slopes", "### The slope story, Figs. 8–9", "### Table VII", "### The slope story, Figs. 10–11",
-            "## Time step")
+            "## Experiment 1", "## Learners side by side", "### Table V", "### Exploration matched",
+            "## Pushes and return maps", "Table VI", "### Push margins",
+            "### The periodic orbit and its Floquet multipliers", "## Slopes", "### The slope story, Figs. 8–9",
+            "### Table VII", "### The slope story, Figs. 10–11", "## Time step", "## Other gaits, and why each exists")
 
 
 @pytest.mark.slow
@@ -108,14 +110,12 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for heading in SECTIONS:
         assert heading in text, heading
     table = [line for line in text.splitlines() if line.startswith("| ") and "**" in line]
-    assert len(table) == 16
+    assert len(table) == 13
     for row in table:  # every verdict row holds a measured number and a verdict
         ours = row.split(" | ")[2]
         assert re.search(r"\d", ours), row
     for figure in ("report_summary.png", "walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
-                   "compare_learners/compare.png", "floquet/none/floquet.png",
-                   "learner_gait/learn/fig6_times.png", "learner_gait/window_map/landscape.png",
-                   "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
+                   "compare_learners/compare.png", "floquet/none/floquet.png", "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
     # The Floquet row says of each orbit whether its multipliers establish anything.
     from drake_biped.analysis.floquet import record_verdict
@@ -125,19 +125,20 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
         assert f"({record_verdict(gait)})" in floquet_row, name
     html = (tmp_path / "report.html").read_text()
     assert html.count("<table>") >= 8 and '<img alt="Fig. 4" src="learn/fig4_reward.png"' in html
-    # The slope story's numbers come from its own record.
-    assert summaries["slope"]["checks"]["no_window"]["climbs"]  # the climbing gait climbs 0.02 rad
-    assert not summaries["slope_default"]["no_window"]["climbs"]  # the default gait does not
-    # The learner's gait: its own walk, and the window its stability runs is the learned one when a trial
-    # learned one that walks, else the map's cheapest.
-    lw, ls = summaries["learner_window_map"], summaries["learner_stability"]
-    assert lw["gait"] == "coasting_wide" and lw["baseline"]["walked"]
-    assert lw["baseline"]["cost_of_transport"] != pytest.approx(summaries["walk"]["cost_of_transport"], rel=0.05)
-    learned = [r for r in summaries["learner_learn"]["evaluation"]["learned"]
+    # One gait: Table VI, the push margins and both slope stories use the learned window, the best learned
+    # trial's when one walks, else the window map's cheapest; the slopes walk the default gait.
+    learned = [r for source in ("learn", "learn_variant") for r in summaries[source]["evaluation"]["learned"]
                if not r["fell"] and r["t2"] > max(0.0, r["t1"])]
-    assert ls["window_source"].startswith("learned") == bool(learned)
-    if not learned and lw["best"] is not None:
-        assert ls["window"] == [round(lw["best"]["t1"], 4), round(lw["best"]["t2"], 4)]
+    window = summaries["push_margin"]["settings"]["window"]
+    assert summaries["stability"]["settings"]["window"] == window
+    assert summaries["push_margin"]["window_source"].startswith("learned") == bool(learned)
+    if not learned and summaries["window_map"]["best"] is not None:
+        best = summaries["window_map"]["best"]
+        assert window == [round(best["t1"], 4), round(best["t2"], 4)]
+    for name in ("slope", "slope2deg"):
+        assert summaries[name]["settings"]["start"] == window
+    assert summaries["slope"]["settings"]["config"]["cpg"] == summaries["learn"]["settings"]["config"]["cpg"]
+    assert summaries["grid_slope2deg"]["base_cpg"] == summaries["learn"]["settings"]["config"]["cpg"]
 
     logs.clear()
     again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append).run_all()
@@ -148,7 +149,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
 
     digest = json.loads((tmp_path / "verdicts.json").read_text())
     assert [r["verdict"] for r in digest["rows"]] == [row.split(" | ")[3].strip(" |*") for row in table]
-    assert digest["checks"]["learner_learn"]["no_window"] == summaries["learner_learn"]["evaluation"]["no_window"][
+    assert digest["checks"]["learn"]["no_window"] == summaries["learn"]["evaluation"]["no_window"][
         "cost_of_transport"]
 
 
@@ -193,7 +194,7 @@ def test_the_packaged_full_run_is_the_shipped_full_runs_verdicts():
     import json
 
     assert full_run_digest() == json.loads(shipped.read_text())
-    assert {r["key"] for r in full_run_digest()["rows"]} >= {"learn", "learner_learn", "stability", "floquet"}
+    assert {r["key"] for r in full_run_digest()["rows"]} >= {"learn", "stability", "floquet"}
 
 
 @pytest.mark.slow
@@ -212,3 +213,52 @@ def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_nu
     text = (tmp_path / "report.md").read_text()
     assert "| this run (quick) | full run (checked here) |" in text
     assert "✓ checked here: 6 re-walks" in text and "not run at this size" in text
+
+
+def test_every_other_shipped_gait_says_why_it_exists():
+    from drake_biped.analysis.reproduce_report import OTHER_GAITS, other_gaits_section
+    from drake_biped.resources import gait_names
+
+    assert set(OTHER_GAITS) == set(gait_names())
+    section = "\n".join(other_gaits_section())
+    assert all(f"| `{name}` | {OTHER_GAITS[name]} |" in section for name in gait_names())
+
+
+def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp_path):
+    import json
+
+    from drake_biped.experiments.reproduce import LEVEL_WINDOW
+
+    r = Reproduction(tmp_path, SMOKE, None, log=lambda _: None)
+    assert r.learned_window() == (LEVEL_WINDOW, "no trial learned one and no window of the map walks", None)
+    (tmp_path / "window_map").mkdir()
+    (tmp_path / "window_map" / "summary.json").write_text(json.dumps({"best": {"t1": 0.31234, "t2": 0.9}}))
+    assert r.learned_window()[:2] == ((0.3123, 0.9), "the window map's cheapest (no trial learned one)")
+
+    def learned(folder, rows):
+        (tmp_path / folder).mkdir(exist_ok=True)
+        (tmp_path / folder / "learning.json").write_text(json.dumps({"evaluation": {"learned": [
+            {"trial": k, "t1": t1, "t2": t2, "cost_of_transport": c, "fell": f} for k, (t1, t2, c, f) in
+            enumerate(rows)]}}))
+
+    learned("learn_variant", [(0.2, 0.6, 0.3, False)])
+    assert r.learned_window()[:2] == ((0.2, 0.6), "learned (learn_variant, trial 0)")
+    # the paper's settings first; of its trials the cheapest that walks with a window
+    learned("learn", [(0.4, 0.3, 0.1, False), (0.41, 1.0, 0.2, True), (0.43, 1.05, 0.25, False),
+                      (-0.1, 0.9, 0.22, False)])
+    assert r.learned_window() == ((0.0, 0.9), "learned (learn, trial 3)", tmp_path / "learn" / "learning.json")
+
+
+def test_the_2deg_grid_raises_the_default_gaits_cpg_as_table_vii_does():
+    from drake_biped.experiments.reproduce import FULL
+    from drake_biped.params import EpisodeConfig
+
+    c, g = EpisodeConfig().cpg, EpisodeConfig().gait
+    axes = {a.name: a.values for a in Reproduction(Path("."), FULL, None).slope_axes()}
+    assert len(axes) == 5 and math.prod(len(v) for v in axes.values()) == 64
+    for k in ("u_a", "u_r", "kappa"):
+        assert axes[f"cpg.{k}"] == (getattr(c, k), round(1.25 * getattr(c, k), 4))
+    assert axes["gait.torso_pitch_rad"][0] == g.torso_pitch_rad and max(axes["gait.torso_pitch_rad"]) == \
+        g.torso_pitch_rad  # leaning further forward only
+    quick = {a.name: a.values for a in Reproduction(Path("."), SMOKE, None).slope_axes()}
+    assert set(quick) == {"gait.torso_pitch_rad", "cpg.u_a"} and all(len(v) == 2 for v in quick.values())

@@ -11,18 +11,17 @@ functions as its own command:
     learn/           Experiment 1 with the paper's settings (Table V, Figs. 4-6)
     learn_variant/   the same with exploration matched to the gait (start 0.4, 0.4; variance 0.01)
     compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
-    stability/       pushes and return maps, none vs 0.2-0.5 s (Table VI, Fig. 7)
-    push_margin/     the largest pushes survived, none vs 0.2-0.5 s
-    floquet/         the periodic orbit's Floquet multipliers: none, 0.2-0.5 s, and the learned window
-    slope_default/   the default gait at the foot of 0.02 rad
-    learner_gait/    the same paper's experiments on LEARNER_GAIT, the gait searched for its learner, beside the
-                     default's: window_map/ (and the policy landscape), learn/ (Experiment 1, the paper's settings),
-                     stability/ (Table VI, push margins and 0.02 rad with the learned window)
-    grid_slope/      forward lean and placement on 0.02 rad; grid_slope2deg/ on 2.0 deg (our Table VII)
-    slope/, slope2deg/  the slope story with the climbing gaits (Figs. 8-11)
+    stability/       pushes and return maps, none vs the learned window (Table VI, Fig. 7)
+    push_margin/     the largest pushes survived, none vs the learned window
+    floquet/         the periodic orbit's Floquet multipliers: none and the learned window
+    grid_slope2deg/  the CPG and the torso's lean raised on 2.0 deg (our Table VII)
+    slope/, slope2deg/  the slope story (Figs. 8-11) from the learned window: 0.02 rad, and 2.0 deg with the
+                     grid's best
 
-then DIR/report.md and DIR/report.html: every table and figure with the paper's value beside ours and a
-verdict for each. `--quick` runs every experiment on small settings (minutes on 2 cores); the full run takes
+All of it on one gait, the default: "the learned window" is the best trial of `learn` (of `learn_variant`
+when the paper's settings learned none; the window map's cheapest when neither did). The other shipped gaits
+are named in the report's closing section, with why each exists. Then DIR/report.md and DIR/report.html:
+every table and figure with the paper's value beside ours and a verdict for each. `--quick` runs every experiment on small settings (minutes on 2 cores); the full run takes
 hours and says so up front.
 
 Nothing lost: each experiment keeps its finished work as its own command does (episodes, trials, grid
@@ -45,17 +44,15 @@ from drake_biped.records import read_json, read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-__all__ = ["FULL", "LEARNER_GAIT", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run", "steps_of"]
+__all__ = ["FULL", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run", "steps_of"]
 
-LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none under pushes (as `stability` defaults)
-SLOPE_START = {"slope": (0.1, 0.6), "slope2deg": (0.1, 0.7)}  # each climbing gait's best level window
+LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none where no window was learned and none of the map walks
 SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
-# The shipped gait searched for the paper's learner (docs/RESULTS.md, "A gait for the paper's learner"): its
-# window map reaches the paper's exploration (t1 to 0.8 s, t2 to 1.2 s) and its landscape is read at the
-# paper's variance and a narrower one.
-LEARNER_GAIT = "coasting_wide"
-LEARNER_MAP = (0.8, 1.2)
-LEARNER_VARIANCES = (0.04, 0.01)
+# The 2.0 deg grid's changes to the default gait: Table VII's CPG parameters raised (the paper: +25 to +51 %)
+# and the torso leaned further forward (rad), with a larger placement gain.
+SLOPE_2DEG_CPG_SCALE = 1.25
+SLOPE_2DEG_LEANS = (0.0, 0.04, 0.08, 0.12)
+SLOPE_2DEG_PLACEMENT = 0.1
 
 
 @dataclass(frozen=True)
@@ -73,14 +70,14 @@ class Profile:
     jacobian: bool
     margin_tolerance_n: float
     slope: tuple[int, int]  # trials, episodes per slope
-    slope_grid_full: bool  # the whole slope grids, or 2 x 2 points through their bests
+    slope_grid_full: bool  # the whole 2.0 deg grid (SLOPE_2DEG_*), or its 2 x 2 corner of lean and u_a
     time_steps: tuple[float, ...]
     time_step_distance_m: float
     expected_minutes: float  # on 2 cores
     compare: tuple[int, int] = (1, 6)  # trials, episodes per learner in the side-by-side comparison
     floquet_epsilons: tuple[float, ...] = ()  # the Floquet sweep's perturbations (empty: its default)
     floquet_newton_iterations: int = 6  # Newton's iterations towards each orbit (FloquetSettings' default)
-    floquet_gaits: tuple[str, ...] = ("none", "window", "learned")  # whose orbits: no window, LEVEL_WINDOW, learned
+    floquet_gaits: tuple[str, ...] = ("none", "learned")  # whose orbits: no window, the learned window
     steps: tuple[str, ...] = ()  # the steps run, in Reproduction.STEPS' order (empty: all of them)
 
     def to_dict(self) -> dict[str, Any]:
@@ -93,8 +90,10 @@ class Profile:
 QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 2.0, floquet_epsilons=(1e-7, 1e-6, 1e-5), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
+# The full run: the committed one's steps took 3.3 h at the closed loop's earlier speed, 1.34 times slower in
+# learning (benchmarks/results/direct-steps-learning.json).
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
-               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 455.0, compare=(5, 300))
+               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 150.0, compare=(5, 300))
 
 
 class Reproduction:
@@ -115,10 +114,30 @@ class Reproduction:
         """The default gait on level ground, walking the profile's distance."""
         return self._walking_the_distance(EpisodeConfig())
 
-    @property
-    def learner_level(self) -> EpisodeConfig:
-        """LEARNER_GAIT on level ground, walking the profile's distance."""
-        return self._walking_the_distance(load_gait(LEARNER_GAIT))
+    def learned_window(self) -> tuple[tuple[float, float], str, Path | None]:
+        """The default gait's learned torque-free period (t1, t2), where it came from, and the learning record
+        it came from: the best learned trial of `learn` (the paper's settings), else of `learn_variant`; else the
+        window map's cheapest, else LEVEL_WINDOW (no record)."""
+        from drake_biped.experiments.learning import best_learned_trial
+
+        for source in ("learn", "learn_variant"):
+            path = self.out / source / "learning.json"
+            try:
+                row = best_learned_trial(read_json(path, "reproduce"), source)
+            except (OSError, ValueError):
+                continue
+            window = (round(max(0.0, float(row["t1"])), 4), round(float(row["t2"]), 4))
+            return window, f"learned ({source}, trial {row['trial']})", path
+        best = self.summary("window_map").get("best")
+        if best is not None:
+            return (round(best["t1"], 4), round(best["t2"], 4)), "the window map's cheapest (no trial learned one)", \
+                None
+        return LEVEL_WINDOW, "no trial learned one and no window of the map walks", None
+
+    def summary(self, step: str) -> dict[str, Any]:
+        """A finished step's summary in this folder; empty when it has none."""
+        saved = read_kept(self.out / step / "summary.json")
+        return saved if isinstance(saved, dict) else {}
 
     def client(self):
         """The reproduction's one client, as a context (it is closed by whoever opened it)."""
@@ -314,12 +333,13 @@ class Reproduction:
         from drake_biped.experiments import stability
 
         p = self.profile
-        settings = stability.StabilitySettings(window=LEVEL_WINDOW, trials=p.stability_trials)
+        window, source, _ = self.learned_window()
+        settings = stability.StabilitySettings(window=window, trials=p.stability_trials)
 
         def run(folder: Path) -> dict:
             record = stability.run(settings, folder, self._client, progress=False, config=self.level,
                                    jacobian_kicks=stability.JACOBIAN_KICKS_RAD if p.jacobian else ())
-            return {"cells": _cells(record)}
+            return {"cells": _cells(record), "window_source": source}
 
         return self.experiment("stability", {**settings.to_dict(), "jacobian": p.jacobian,
                                              "distance_m": p.distance_m}, run)
@@ -328,29 +348,24 @@ class Reproduction:
         from drake_biped.experiments import push_margin
 
         tol = self.profile.margin_tolerance_n
+        window, source, _ = self.learned_window()
 
         def run(folder: Path) -> dict:
-            record = push_margin.run(push_margin.PushMarginSettings(self.level, LEVEL_WINDOW, 200.0, tol), folder,
+            record = push_margin.run(push_margin.PushMarginSettings(self.level, window, 200.0, tol), folder,
                                      self._client, progress=False)
-            return {"margins": _margins(record)}
+            return {"margins": _margins(record), "window_source": source}
 
-        return self.experiment("push_margin", {"tolerance_n": tol, "window": list(LEVEL_WINDOW),
+        return self.experiment("push_margin", {"tolerance_n": tol, "window": list(window),
                                                "distance_m": self.profile.distance_m}, run)
 
     def floquet(self) -> dict:
         from drake_biped.experiments import floquet
-        from drake_biped.experiments.learning import best_learned_trial
 
-        windows = {"none": (0.0, 0.0), "window": LEVEL_WINDOW}
-        for source in ("learn", "learn_variant") if "learned" in self.profile.floquet_gaits else ():
-            # the learned window: the paper's settings' if they learned one
-            try:
-                row = best_learned_trial(read_json(self.out / source / "learning.json", "reproduce"), source)
-            except (OSError, ValueError):
-                continue
-            windows["learned"] = (max(0.0, float(row["t1"])), max(0.0, float(row["t2"])))
-            break
-        windows = {k: v for k, v in windows.items() if k in self.profile.floquet_gaits}
+        windows = {"none": (0.0, 0.0)}
+        if "learned" in self.profile.floquet_gaits:
+            window, source, _ = self.learned_window()
+            if source.startswith("learned"):
+                windows["learned"] = window
 
         def run(folder: Path) -> dict:
             out = {}
@@ -371,151 +386,73 @@ class Reproduction:
         return self.experiment("floquet", {"windows": {k: list(v) for k, v in windows.items()},
                                            "distance_m": self.profile.distance_m}, run)
 
-    def slope_default(self) -> dict:
-        from drake_biped.experiments.executor import run_kept
-        from drake_biped.experiments.slope import climbs, slope_ground
+    def slope_axes(self) -> list:
+        """The 2.0 deg grid's axes around the default gait (SLOPE_2DEG_*): its torso leaned further forward, a
+        larger placement gain, and u_a, u_r, kappa raised as in Table VII; or the 2 x 2 corner of lean and u_a."""
+        from drake_biped.experiments.grid import Axis
 
-        def run(folder: Path) -> dict:
-            config = EpisodeConfig().replace(ground=slope_ground(SLOPE_RAD))
-            jobs = {"no_window": config, "window": config.replace(window=TorqueFreeWindow(*LEVEL_WINDOW))}
-            with self.client() as client:
-                results = run_kept(client, {k: (folder / f"{k}.json", c.to_dict()) for k, c in jobs.items()})
-            return {k: {"distance_m": r["distance_m"], "climbs": climbs(r)} for k, r in results.items()}
+        g, c = self.level.gait, self.level.cpg
+        lean = Axis("gait.torso_pitch_rad", tuple(round(g.torso_pitch_rad - d, 4) for d in SLOPE_2DEG_LEANS))
+        raised = [Axis(f"cpg.{k}", (getattr(c, k), round(SLOPE_2DEG_CPG_SCALE * getattr(c, k), 4)))
+                  for k in ("u_a", "u_r", "kappa")]
+        if not self.profile.slope_grid_full:
+            return [Axis(lean.name, (lean.values[0], lean.values[2])), raised[0]]
+        return [lean, Axis("gait.placement_gain", (g.placement_gain, round(g.placement_gain + SLOPE_2DEG_PLACEMENT, 4))),
+                *raised]
 
-        return self.experiment("slope_default", {"slope_rad": SLOPE_RAD, "window": list(LEVEL_WINDOW)}, run)
-
-    def _slope_grid(self, name: str, spec: str, base_file: str | None, slope: float,
-                    subset: dict[str, list[float]]):
-        """A grid on 2 m level then `slope`, from the default gait (base_file None) or a shipped gait: the
-        shipped grid spec `spec` (full), or the 2 x 2 `subset` through its best (quick)."""
+    def grid_slope2deg(self) -> dict:
+        """Table VII: the default gait's grid (slope_axes) on 2 m level then 2.0 deg."""
         from drake_biped.experiments import grid
-        from drake_biped.experiments.grid import Axis, field_name, load_spec
         from drake_biped.experiments.slope import slope_ground
 
-        full = self.profile.slope_grid_full
-        settings = {"spec": spec if full else subset, "base": base_file, "slope_rad": slope}
+        axes = self.slope_axes()
+        settings = {"axes": {a.name: list(a.values) for a in axes}, "slope_rad": SLOPE_2DEG_RAD_PRINTED}
 
         def run(folder: Path) -> dict:
-            axes = load_spec(spec) if full else [Axis(field_name(k), tuple(v)) for k, v in subset.items()]
-            base = (EpisodeConfig() if base_file is None else load_gait(base_file)).replace(ground=slope_ground(slope))
+            base = EpisodeConfig().replace(ground=slope_ground(SLOPE_2DEG_RAD_PRINTED))
             record = grid.run(grid.GridSettings(base, tuple(axes)), folder, self._client, progress=False,
                               workers=self.workers, scheduler=self.scheduler)
             return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
                     "base_cpg": base.cpg.to_dict()}
 
-        return self.experiment(name, settings, run)
+        return self.experiment("grid_slope2deg", settings, run)
 
-    def grid_slope(self) -> dict:
-        return self._slope_grid("grid_slope", "slope_0.02", None, SLOPE_RAD,
-                                {"gait.torso_pitch_rad": [-0.2226, -0.30], "gait.placement_gain": [0.356, 0.45]})
-
-    def grid_slope2deg(self) -> dict:
-        return self._slope_grid("grid_slope2deg", "slope_2deg", "climbing", SLOPE_2DEG_RAD_PRINTED,
-                                {"gait.torso_pitch_rad": [-0.34, -0.38], "u_a": [1.6291, 2.0]})
-
-    def _slope(self, name: str, base_file: str, slope: float) -> dict:
+    def _slope(self, name: str, slope: float, point: dict[str, float] | None = None) -> dict:
+        """The slope story on the default gait (with the grid's `point` put in) from the learned window: the
+        learner starts from its learning record's state when a trial learned one, else from the window with
+        the paper's variance."""
         from drake_biped.experiments import slope as slope_experiment
+        from drake_biped.experiments.grid import point_config
 
         trials, episodes = self.profile.slope
-        t1, t2 = SLOPE_START[name]
-        settings = {"params": base_file, "slope_rad": slope, "start": [t1, t2], "variance": 0.04,
+        window, source, policy = self.learned_window()
+        config = EpisodeConfig() if not point else point_config(EpisodeConfig(), point)
+        settings = {"config": config.to_dict(), "slope_rad": slope, "start": list(window), "start_source": source,
+                    "policy": None if policy is None else str(policy.relative_to(self.out)), "variance": 0.04,
                     "trials": trials, "episodes": episodes}
 
         def run(folder: Path) -> dict:
             record = slope_experiment.run(
-                slope_experiment.SlopeSettings(load_gait(base_file), slope, window=(t1, t2), variance=0.04,
-                                               trials=trials, episodes=episodes, gait=base_file),
+                slope_experiment.SlopeSettings(config, slope, policy=None if policy is None else str(policy),
+                                               window=window, variance=0.04, trials=trials, episodes=episodes),
                 folder, self._client, progress=False, workers=self.workers, scheduler=self.scheduler)
-            return {k: record[k] for k in ("checks", "verdicts", "trials", "start")}
+            return {**{k: record[k] for k in ("checks", "verdicts", "trials", "start")}, "start_source": source,
+                    "point": point or {}}
 
         return self.experiment(name, settings, run)
 
     def slope(self) -> dict:
-        return self._slope("slope", "climbing", SLOPE_RAD)
+        return self._slope("slope", SLOPE_RAD)
 
     def slope2deg(self) -> dict:
-        return self._slope("slope2deg", "climbing_2deg", SLOPE_2DEG_RAD_PRINTED)
+        """The slope story on 2.0 deg with the 2.0 deg grid's best point (the default gait when none climbs)."""
+        grid = self.summary("grid_slope2deg")
+        climbs = grid.get("walked") and grid.get("best")
+        return self._slope("slope2deg", SLOPE_2DEG_RAD_PRINTED, grid["best"]["point"] if climbs else None)
 
-    def learner_window_map(self) -> dict:
-        """LEARNER_GAIT's windows up to LEARNER_MAP against none, and what GARB's policy expects on them."""
-        from drake_biped.experiments import landscape, window_map
-
-        step, config = self.profile.window_step_s, self.learner_level
-
-        def run(folder: Path) -> dict:
-            rec = window_map.run(window_map.WindowMapSettings(config, *LEARNER_MAP, t1_step_s=step, t2_step_s=step),
-                                 folder, self._client, progress=False)
-            land = landscape.run(landscape.LandscapeSettings(str(folder / "window_map.json"), LEARNER_VARIANCES),
-                                 folder, progress=False)
-            base = rec["baseline"]
-            return {"gait": LEARNER_GAIT,
-                    "baseline": {k: base[k] for k in ("walked", "distance_m", "cost_of_transport", "mean_speed_mps",
-                                                      "step_period_s")},
-                    **_map_summary(rec),
-                    "landscape": [{"variance": v["variance"], "start_gain": v["starts"][0]["gain"],
-                                   "best_gain": v["best_gain"], "best_mean": v["best_mean"]}
-                                  for v in land["variances"]]}
-
-        return self.experiment(self.folder("learner_window_map"), {"gait": LEARNER_GAIT, "config": config.to_dict(),
-                                                           "map": list(LEARNER_MAP), "step_s": step,
-                                                           "variances": list(LEARNER_VARIANCES)}, run)
-
-    def learner_learn(self) -> dict:
-        """Experiment 1 with the paper's settings on LEARNER_GAIT."""
-        trials, episodes = self.profile.learn
-        return self._learn(self.folder("learner_learn"), trials, episodes, (0.5, 0.5), 0.04, self.learner_level)
-
-    def learner_stability(self) -> dict:
-        """Table VI, the push margins and the foot of 0.02 rad for LEARNER_GAIT, none against its learned window
-        (the best learned trial's; the window map's cheapest when no trial learned one)."""
-        from drake_biped.experiments import push_margin, stability
-        from drake_biped.experiments.executor import run_kept
-        from drake_biped.experiments.learning import best_learned_trial
-        from drake_biped.experiments.slope import climbs, slope_ground
-
-        p, config = self.profile, self.learner_level
-        try:
-            row = best_learned_trial(read_json(self.out / self.folder("learner_learn") / "learning.json", "reproduce"))
-            source, window = f"learned (trial {row['trial']})", (max(0.0, float(row["t1"])), float(row["t2"]))
-        except (OSError, ValueError):
-            best = read_kept(self.out / self.folder("learner_window_map") / "summary.json")["best"]
-            source, window = "the window map's cheapest (no trial learned one)", \
-                (LEVEL_WINDOW if best is None else (best["t1"], best["t2"]))
-        window = (round(window[0], 4), round(window[1], 4))
-        settings = stability.StabilitySettings(window=window, trials=p.stability_trials)
-
-        def run(folder: Path) -> dict:
-            cells = _cells(stability.run(settings, folder / "table_vi", self._client, progress=False, config=config,
-                                         jacobian_kicks=()))
-            margins = _margins(push_margin.run(push_margin.PushMarginSettings(config, window, 200.0,
-                                                                              p.margin_tolerance_n),
-                                               folder / "push_margin", self._client, progress=False))
-            slope = config.replace(ground=slope_ground(SLOPE_RAD),
-                                   sim=dataclasses.replace(config.sim, distance_m=EpisodeConfig().sim.distance_m))
-            jobs = {"no_window": slope, "window": slope.replace(window=TorqueFreeWindow(*window))}
-            with self.client() as client:
-                results = run_kept(client, {k: (folder / "slope" / f"{k}.json", c.to_dict()) for k, c in jobs.items()})
-            return {"window": list(window), "window_source": source, "cells": cells, "margins": margins,
-                    "slope": {k: {"distance_m": r["distance_m"], "climbs": climbs(r)} for k, r in results.items()}}
-
-        return self.experiment(self.folder("learner_stability"), {**settings.to_dict(), "gait": LEARNER_GAIT,
-                                                          "tolerance_n": p.margin_tolerance_n,
-                                                          "slope_rad": SLOPE_RAD, "distance_m": p.distance_m}, run)
-
-    # Where a step's folder is not its name.
-    FOLDERS = {"learner_window_map": "learner_gait/window_map", "learner_learn": "learner_gait/learn",
-               "learner_stability": "learner_gait/stability"}
-
-    @classmethod
-    def folder(cls, step: str) -> str:
-        """The folder of DIR that holds `step`'s work and summary."""
-        return cls.FOLDERS.get(step, step)
-
-    # The learner's gait, which carries the paper's learning result, runs early, so that an interrupted run
-    # has it first.
-    STEPS = ("walk", "time_step", "grid", "table_iii", "paper_gait", "full_run", "learner_window_map", "learner_learn", "learner_stability",
-             "window_map", "learn", "learn_variant", "compare_learners", "stability", "push_margin", "floquet",
-             "slope_default", "grid_slope", "grid_slope2deg", "slope", "slope2deg")
+    STEPS = ("walk", "time_step", "grid", "table_iii", "paper_gait", "full_run", "window_map", "learn",
+             "learn_variant", "compare_learners", "stability", "push_margin", "floquet", "grid_slope2deg", "slope",
+             "slope2deg")
 
     def run_all(self) -> dict[str, dict]:
         self.out.mkdir(parents=True, exist_ok=True)
