@@ -142,7 +142,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
 
     logs.clear()
     again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append).run_all()
-    assert logs == [f"[{Reproduction.folder(step)}] finished earlier: reused" for step in steps_of(SMOKE)]
+    assert logs == [f"[{step}] finished earlier: reused" for step in steps_of(SMOKE)]
     assert again == summaries and (tmp_path / "report.md").read_text() == text
     # a full run leaves what a quick run checks: its verdict rows, keyed, and its learned windows' C_mt
     import json
