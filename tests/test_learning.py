@@ -62,6 +62,39 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
     assert {"t1", "t2", "reward", "cost_of_transport", "distance_m", "fell"} <= set(first[0])
 
 
+class _CountingClient:
+    """A client that keeps the configuration of every episode submitted to it."""
+
+    def __init__(self, client):
+        self.client, self.submitted = client, []
+
+    def submit(self, fn, config, **options):
+        self.submitted.append(config)
+        return self.client.submit(fn, config, **options)
+
+
+def test_draws_without_a_window_are_walked_once_and_give_each_trial_that_walks_result(tmp_path, client,
+                                                                                   monkeypatch):
+    """Every draw with t2 <= t1 walks the same episode: one walk serves them all, and the trials' records are
+    those of walking every draw, to the byte."""
+    from drake_biped.experiments import learning
+
+    settings = _settings(episodes=6, trials=2)
+    once = _CountingClient(client)
+    run_learning(tmp_path / "once", settings, once)
+    monkeypatch.setattr(learning, "episode_key", lambda config: None)
+    every = _CountingClient(client)
+    run_learning(tmp_path / "every", settings, every)
+    for k in range(2):
+        path = f"trials/trial_{k}.json"
+        assert (tmp_path / "once" / path).read_bytes() == (tmp_path / "every" / path).read_bytes()
+    draws = [e for trial in _episodes(tmp_path / "once") for e in trial]
+    without = sum(not window_of((e["t1"], e["t2"])).active for e in draws)
+    assert without >= 2  # the seed draws several: a check that can fail
+    assert len(every.submitted) == 12 and len(once.submitted) == 12 - without + 1
+    assert sum(not EpisodeConfig.from_dict(c).window.active for c in once.submitted) == 1
+
+
 def test_a_shorter_run_is_replayed_from_a_longer_ones_records(tmp_path, client):
     """The records of a 1 x 3 run, replayed from a 1 x 5 run of the same settings, are the 1 x 3 run's own
     to the byte; other settings, or a record the learner cannot have drawn, give none."""

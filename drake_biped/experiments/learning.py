@@ -26,6 +26,7 @@ means no torque-free period, as in the paper.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -270,6 +271,16 @@ def replay_run(source: Path, out: Path, settings: dict[str, Any]) -> bool:
     return True
 
 
+def episode_key(config: dict[str, Any]) -> str | None:
+    """The key under which run_learning walks a configuration once: every configuration whose window is
+    inactive (t2 <= t1) walks the same episode, whatever its window's numbers (the gate is exactly 0 there, and
+    episodes are deterministic). None for an active window (a learner's draws of one almost never repeat)."""
+    window = config["window"]
+    if window["end_s"] > window["start_s"]:
+        return None
+    return json.dumps({**config, "window": None}, sort_keys=True)
+
+
 def run_learning(
     out: Path,
     settings: dict[str, Any],
@@ -279,9 +290,11 @@ def run_learning(
 ) -> tuple[list[Trial], int]:
     """Run (or resume) every trial to settings["episodes"] on the Dask `client`.
 
-    progress(done, total, latest_mean_reward) after each recorded episode. stop_after: return once this
-    many new episodes are recorded (for tests of resuming). Returns the trials and the number of episodes
-    this call recorded."""
+    Draws without a window are walked once per call (`episode_key`): a trial whose draw has no window takes the
+    result of that walk (waiting for it while it runs), which is the result its own walk would give, so the
+    records are those of walking every episode. progress(done, total, latest_mean_reward) after each recorded
+    episode. stop_after: return once this many new episodes are recorded (for tests of resuming). Returns the
+    trials and the number of episodes this call recorded."""
     from distributed import as_completed
 
     from drake_biped.experiments.executor import episode_task
@@ -294,27 +307,58 @@ def run_learning(
     latest: dict[int, float] = {t.index: t.episodes[-1]["reward"] for t in trials if t.episodes}
     if progress is not None:
         progress(done, total, float(np.mean(list(latest.values()))) if latest else None)
-    futures = {}
-    for t in trials:
-        if t.done < settings["episodes"]:
-            futures[client.submit(episode_task, t.next_config(), pure=False)] = t
+    walked: dict[str, dict[str, Any]] = {}  # episode_key -> the result of its walk
+    in_flight: dict[str, Any] = {}  # episode_key -> the future walking it
+    waiting: dict[Any, tuple[str | None, list[Trial]]] = {}  # a walk in flight -> its key, the trials taking it
+    queue = as_completed()
     new = 0
-    queue = as_completed(list(futures))
-    for future in queue:
-        t = futures.pop(future)
-        row = t.record(future.result())
+
+    def finish(t: Trial, result: dict[str, Any]) -> bool:
+        """Record `t`'s episode; whether to stop (stop_after reached)."""
+        nonlocal new
+        row = t.record(result)
         new += 1
         latest[t.index] = row["reward"]
         if progress is not None:
             progress(sum(x.done for x in trials), total, float(np.mean(list(latest.values()))))
-        if stop_after is not None and new >= stop_after:
-            for f in futures:
-                f.cancel()
+        return stop_after is not None and new >= stop_after
+
+    def advance(t: Trial) -> bool:
+        """Give `t` its next episodes: recorded at once while they repeat a finished walk without a window, then
+        one walk joined or submitted. Whether to stop."""
+        while t.done < settings["episodes"]:
+            config = t.next_config()
+            key = episode_key(config)
+            if key in walked:
+                if finish(t, walked[key]):
+                    return True
+                continue
+            future = in_flight.get(key) if key is not None else None
+            if future is None:
+                future = client.submit(episode_task, config, pure=False)
+                waiting[future] = (key, [])
+                queue.add(future)
+                if key is not None:
+                    in_flight[key] = future
+            waiting[future][1].append(t)
+            return False
+        return False
+
+    stop = any(advance(t) for t in trials)
+    for future in queue:
+        if stop:
             break
-        if t.done < settings["episodes"]:
-            f = client.submit(episode_task, t.next_config(), pure=False)
-            futures[f] = t
-            queue.add(f)
+        result = future.result()
+        key, takers = waiting.pop(future)
+        if key is not None:
+            walked[key] = result
+            del in_flight[key]
+        for t in takers:
+            if finish(t, result) or advance(t):
+                stop = True
+                break
+    for f in waiting:
+        f.cancel()
     return trials, new
 
 
