@@ -70,6 +70,16 @@ def test_table_vii_compares_the_direction_of_each_change():
     assert rows[0] == "| u_a | 2 → 2.74 (+37.0 %) | 1.6 → 2 (+25.0 %) |"
 
 
+def test_table_vii_is_not_reproduced_when_no_point_climbs():
+    """A grid whose best point is its furthest fall gives no 2.0° parameters to compare with Table VII."""
+    summary = {"base_cpg": {"u_a": 1.6, "u_r": 4.6, "kappa": 2.6}, "points": 64, "walked": 0,
+               "best": {"point": {"cpg.kappa": 3.25}, "distance_m": 2.536}}
+    _, changes, verdict = table_vii_rows(summary)
+    assert changes == "no point climbs (the furthest falls at 2.54 m)"
+    assert verdict == NOT_REPRODUCED + ": none of the grid's 64 points climbs 2.0°"
+    assert table_vii_rows({**summary, "walked": 3})[2].startswith("differs: 1 of 3")
+
+
 def test_embedded_reports_keep_their_figures_and_sit_below_the_main_headings():
     text = "# Title\n\n## Part\n\n![Fig](fig7.png) [data](sub/x.json) [web](https://x.org/a) [anchor](#top)\n"
     out = embed(text, "stability")
