@@ -115,6 +115,11 @@ def stability_verdict(cells: dict[str, Any]) -> tuple[str, str]:
     return ours, f"{NOT_REPRODUCED}: {6 - stable} cell(s) not stable"
 
 
+def climbs_2deg(summary: dict[str, Any]) -> bool:
+    """Whether any point of the 2.0 deg grid (its summary) climbs: else its best is only the furthest fall."""
+    return bool(summary.get("walked"))
+
+
 def table_vii_rows(summary: dict[str, Any]) -> tuple[list[str], str, str]:
     """Table VII's rows (paper and ours), our changes in a line, and the verdict."""
     base, best = summary["base_cpg"], summary["best"]["point"]
@@ -129,12 +134,9 @@ def table_vii_rows(summary: dict[str, Any]) -> tuple[list[str], str, str]:
         changes.append(f"{name} {_pct(ours_change)}")
     others = [f"{k} = {v:.4g}" for k, v in best.items() if not k.startswith("cpg.")]
     note = f"; also {', '.join(others)}" if others else ""
-    if not summary.get("walked", 1):
-        # No point climbs: the furthest fall is no gait for the slope, and its parameters no Table VII.
-        furthest = summary["best"].get("distance_m")
-        where = "" if furthest is None else f" (the furthest falls at {furthest:.2f} m)"
-        return (rows, f"no point climbs{where}",
-                f"{NOT_REPRODUCED}: none of the grid's {summary.get('points', '?')} points climbs 2.0°")
+    if not climbs_2deg(summary):  # the furthest fall is no 2.0 deg gait, and its parameters no Table VII
+        return (rows, f"no point climbs (the furthest falls at {summary['best']['distance_m']:.2f} m)",
+                f"{NOT_REPRODUCED}: none of the grid's {summary['points']} points climbs 2.0°")
     return rows, ", ".join(changes), f"{DIFFERS}: {same} of 3 CPG parameters move as in Table VII{note}"
 
 
@@ -226,7 +228,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append(("Full-state Floquet multipliers (periodic orbit, through Drake)", "—",
                      ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
                                for name, g in fl.items()), BEYOND))
-    on_2deg = "with the grid's best" if s.get("slope2deg", {}).get("point") else "on the default gait (no grid point climbs)"
+    on_2deg = ("with the grid's best" if climbs_2deg(s["grid_slope2deg"])
+               else "on the default gait (no grid point climbs)")
     for name, label in (("slope", "Slope story, 0.02 rad (Figs. 8–9)"),
                         ("slope2deg", f"Slope story, 2.0° {on_2deg} (Figs. 10–11)")):
         ours, verdict = slope_verdict(s[name])
@@ -361,7 +364,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                 "best (the default gait itself when no point climbs).",
                 "",
                 "| parameter | paper: Table III → Table VII | ours: default → "
-                + ("2.0° best |" if g2["walked"] else "the furthest fall (nothing climbs) |"),
+                + ("2.0° best |" if climbs_2deg(g2) else "the furthest fall (nothing climbs) |"),
                 "|---|---|---|",
                 *vii_rows,
                 "",

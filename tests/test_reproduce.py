@@ -62,7 +62,7 @@ def test_stability_verdict_counts_stable_cells_and_the_largest_difference():
 
 
 def test_table_vii_compares_the_direction_of_each_change():
-    summary = {"base_cpg": {"u_a": 1.6, "u_r": 4.6, "kappa": 2.6},
+    summary = {"base_cpg": {"u_a": 1.6, "u_r": 4.6, "kappa": 2.6}, "points": 64, "walked": 12,
                "best": {"point": {"cpg.u_a": 2.0, "cpg.kappa": 2.0, "gait.torso_pitch_rad": -0.38}}}
     rows, changes, verdict = table_vii_rows(summary)
     assert changes == "u_a +25.0 %, u_r 0.0 %, kappa -23.1 %"  # no change prints without a sign

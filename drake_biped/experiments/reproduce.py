@@ -446,9 +446,10 @@ class Reproduction:
 
     def slope2deg(self) -> dict:
         """The slope story on 2.0 deg with the 2.0 deg grid's best point (the default gait when none climbs)."""
+        from drake_biped.analysis.reproduce_report import climbs_2deg
+
         grid = self.summary("grid_slope2deg")
-        climbs = grid.get("walked") and grid.get("best")
-        return self._slope("slope2deg", SLOPE_2DEG_RAD_PRINTED, grid["best"]["point"] if climbs else None)
+        return self._slope("slope2deg", SLOPE_2DEG_RAD_PRINTED, grid["best"]["point"] if climbs_2deg(grid) else None)
 
     # The paper's claims first; the learners side by side, beyond the paper and the costliest step, last.
     STEPS = ("walk", "time_step", "grid", "table_iii", "paper_gait", "full_run", "window_map", "learn",
