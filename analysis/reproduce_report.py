@@ -152,18 +152,24 @@ OTHER_GAITS = {
     "paper_entrained": "Table III and the paper's initiation under the entrained phase reading (the CPG runs "
                        "free, ζ's sign picks the swing): walks 10 m (C_mt 0.175) but falls from 0.95 or 1.05 × the "
                        "initiation speed and to ±20 N pushes",
-    "climbing": "the 0.02 rad grid's best from the default gait (torso leaned forward, larger placement gain): "
+    "climbing": "the 0.02 rad grid's best from `steady` (torso leaned forward, larger placement gain): "
                 "climbs 0.02 rad without a window",
     "climbing_2deg": "the 2.0° grid's best from `climbing` (u_a raised, torso leaned further): climbs 2.0°",
     "attracting": "searched for a period-1 orbit that attracts (Floquet ρ 0.08): slower and less push-robust "
-                  "than the default",
+                  "than `steady`",
     "coasting": "searched so that its swing coasts to touchdown (hip off from 0.3 or 0.4 s walks 10 m)",
     "coasting_garb": "searched from `coasting` for the paper's start policy, whose expected reward at (0.5, 0.5) "
                      "beats no window; Table VI fails with its learned window",
     "coasting_wide": "searched from `coasting_garb` by that expected reward: GARB with the paper's settings saves "
                      "48.8 % at 0.5 ms, but three of its five windows start past the end of its powered step and "
                      "save 14–39 % at 0.25 ms",
+    "steady": "the first default: walks from the paper's initiation at C_mt 0.219 and through 75 / 47 N pushes, "
+              "but GARB with the paper's settings learns no window on it (0 of 5) and its orbit is a saddle",
 }
+
+
+def _steps(n: int) -> str:
+    return f"{n} step" if n == 1 else f"{n} steps"
 
 
 def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]]:
@@ -199,10 +205,10 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     grid = s["grid"]
     t3 = grid["table_iii"]
     verdicts.append(("Table III walks", "walks (the grid's best)",
-                     f"falls after {t3['steps']} steps, {t3['distance_m']:.2f} m", NOT_REPRODUCED))
+                     f"falls after {_steps(t3['steps'])}, {t3['distance_m']:.2f} m", NOT_REPRODUCED))
     pg = s["paper_gait"]
     verdicts.append(("Table III walks, ζ driving the swing as printed (unprinted gains searched)", "walks",
-                     ("walks" if not pg["fell"] else f"falls after {pg['steps']} steps") + f", {pg['distance_m']:.2f} m",
+                     ("walks" if not pg["fell"] else f"falls after {_steps(pg['steps'])}") + f", {pg['distance_m']:.2f} m",
                      REPRODUCED if not pg["fell"] else NOT_REPRODUCED))
     best = grid["best"]
     verdicts.append(("Table IV grid: furthest walk", "Table III, walks",
@@ -268,7 +274,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"{grid['points']} points over Table IV's CPG ranges and the initiation, level ground, one episode each: "
         f"{grid['walked']} walk 10 m; the furthest, {best['distance_m']:.2f} m, at "
         + ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in best["point"].items())
-        + f". Table III itself (with the default gait's other gains) falls after {t3['steps']} steps "
+        + f". Table III itself (with the default gait's other gains) falls after {_steps(t3['steps'])} "
         f"({t3['distance_m']:.2f} m). The default gait's CPG: "
         + ", ".join(f"{k} {v:.4g}" for k, v in s["learn"]["settings"]["config"]["cpg"].items()) + ".",
         "",
@@ -281,7 +287,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"The shipped gait `paper`: Table III's CPG ({', '.join(f'{k} {v:g}' for k, v in pg['cpg'].items())}) and the "
         f"paper's initiation, ζ driving the swing unscaled (the integrated reading), the gains the paper does not "
         f"print from a search of 1 430 candidates (docs/RESULTS.md): "
-        + ("walks 10 m" if not pg["fell"] else f"falls after {pg['steps']} steps ({pg['fall_reason']}), "
+        + ("walks 10 m" if not pg["fell"] else f"falls after {_steps(pg['steps'])} ({pg['fall_reason']}), "
                                               f"{pg['distance_m']:.2f} m")
         + ". Record: [result.json](paper_gait/result.json).",
         "",
@@ -536,11 +542,11 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
     mine: dict[str, tuple[str, str]] = {}
     if "table_iii" in s:
         t3 = s["table_iii"]
-        mine["table_iii"] = (("walks" if not t3["fell"] else f"falls after {t3['steps']} steps")
+        mine["table_iii"] = (("walks" if not t3["fell"] else f"falls after {_steps(t3['steps'])}")
                              + f", {t3['distance_m']:.2f} m", REPRODUCED if not t3["fell"] else NOT_REPRODUCED)
     if "paper_gait" in s:
         pg = s["paper_gait"]
-        mine["paper_gait"] = (("walks" if not pg["fell"] else f"falls after {pg['steps']} steps")
+        mine["paper_gait"] = (("walks" if not pg["fell"] else f"falls after {_steps(pg['steps'])}")
                               + f", {pg['distance_m']:.2f} m", REPRODUCED if not pg["fell"] else NOT_REPRODUCED)
     if "learn" in s:
         ours, _ = reduction_verdict(s["learn"]["evaluation"])
@@ -560,11 +566,32 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
     return rows
 
 
+def full_run_gait(full_run: dict[str, Any] | None) -> str | None:
+    """The gait the shipped full run was measured on, when it is not today's default: the shipped gait's name
+    (`--params NAME`) whose CPG, gains and initiation its checks walked, else "another gait"; None when it is
+    the default gait (or the full run records no checks)."""
+    from drake_biped.params import EpisodeConfig
+    from drake_biped.resources import gait_names, load_gait
+
+    configs = [c["config"] for c in (full_run or {}).get("checks", {}).values() if "config" in c]
+    if not configs:
+        return None
+    sections = ("cpg", "gait", "initial")
+    same = lambda a, b: all(a.get(k) == b.get(k) for k in sections)  # noqa: E731
+    if same(configs[0], EpisodeConfig().to_dict()):
+        return None
+    for name in gait_names():
+        if same(configs[0], load_gait(name).to_dict()):
+            return f"`{name}`"
+    return "another gait"
+
+
 def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any],
                           full_run: dict[str, Any] | None) -> str:
     rows = quick_rows(s, full_run)
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
-    quick_summary_figure(rows, out / "report_summary.png")
+    other = full_run_gait(full_run)
+    quick_summary_figure(rows, out / "report_summary.png", other)
     walk, fr = s["walk"], s.get("full_run") or {}
     full_code = (full_run or {}).get("code", {})
     lines = [
@@ -578,6 +605,11 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         f"Drake {full_code.get('drake')}). The full run's learned windows, and no window, were walked again "
         "here: where they give the C_mt the full run recorded, its row says so (✓).",
         "",
+    ]
+    if other is not None:
+        lines += [f"The shipped full run was measured on {other}, not on the default gait this run walks: its "
+                  "column is that gait's (its windows were walked again on it).", ""]
+    lines += [
         "| what | paper | this run (quick) | full run (checked here) |",
         "|---|---|---|---|",
     ]
@@ -614,8 +646,9 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
     return "\n".join(lines)
 
 
-def quick_summary_figure(rows: list[dict[str, str]], path: Path) -> None:
-    """The quick report's table as a picture: this run's column beside the full run's, each verdict coloured."""
+def quick_summary_figure(rows: list[dict[str, str]], path: Path, full_gait: str | None = None) -> None:
+    """The quick report's table as a picture: this run's column beside the full run's, each verdict coloured;
+    `full_gait`: the full run's gait when it is not the default (full_run_gait)."""
     import textwrap
 
     import matplotlib
@@ -646,6 +679,7 @@ def quick_summary_figure(rows: list[dict[str, str]], path: Path) -> None:
             if verdict and verdict.startswith(key):
                 cell.set_facecolor(colour)
                 break
-    ax.set_title("drake-biped reproduce (quick): this run beside the shipped full run", fontsize=10)
+    ax.set_title("drake-biped reproduce (quick): this run beside the shipped full run"
+                 + (f" (measured on {full_gait.strip('`')})" if full_gait else ""), fontsize=10)
     save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)

@@ -1,6 +1,7 @@
 """A short walk: it walks, its energy books balance, its record is complete."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -114,11 +115,12 @@ def test_push_is_wired_only_when_requested():
 
 
 def test_a_torque_free_window_saves_the_hips_work_on_a_short_walk():
-    """The property of the slow 5 m test below, on 2 m (the first steps, the initiation's included): the
-    freed hip does less positive work per metre (measured -29 %) and the walk costs less (-8 %)."""
+    """The property of the slow 5 m test below, on 2 m (the first steps, the initiation's included): the hip
+    freed from 0.2 s until the foot lands does less positive work per metre (measured -25 %) and the walk
+    costs less (-27 %)."""
     sim = SimulationParams(distance_m=2.0, max_time_s=10.0)
     base = run_episode(EpisodeConfig(sim=sim))
-    gated = run_episode(EpisodeConfig(sim=sim, window=TorqueFreeWindow(0.2, 0.5)))
+    gated = run_episode(EpisodeConfig(sim=sim, window=TorqueFreeWindow(0.2, 1.2)))
     assert not base.fell and not gated.fell
     hips = lambda r: r.positive_work_j["left_hip"] + r.positive_work_j["right_hip"]  # noqa: E731
     assert hips(gated) / gated.distance_m < 0.8 * hips(base) / base.distance_m
@@ -127,22 +129,24 @@ def test_a_torque_free_window_saves_the_hips_work_on_a_short_walk():
 
 @pytest.mark.slow
 def test_torque_free_window_saves_energy_without_a_fall():
-    """The default gait's defining property: freeing the swing hip for (0.2, 0.5) s of each step
-    walks as far with clearly less positive work per metre (measured: -27% over 10 m)."""
-    sim = SimulationParams(distance_m=5.0, max_time_s=20.0)
-    base = run_episode(EpisodeConfig(sim=sim))
-    gated = run_episode(EpisodeConfig(sim=sim, window=TorqueFreeWindow(0.2, 0.5)))
-    assert not base.fell and not gated.fell
-    assert gated.cost_of_transport < 0.85 * base.cost_of_transport
-    hips = lambda r: r.positive_work_j["left_hip"] + r.positive_work_j["right_hip"]  # noqa: E731
-    assert hips(gated) / gated.distance_m < 0.85 * hips(base) / base.distance_m
+    """The default gait's defining property: its swing hip off from 0.3 s after each touchdown until the foot
+    lands (t2 past any step), it walks 10 m for much less, and as much less at half the plant step (measured
+    with the 0.1326 rad initiation of its search: -49.9 %, and -44.4 % at 0.5 ms)."""
+    for step in (1e-3, 5e-4):
+        sim = SimulationParams(time_step_s=step)
+        base = run_episode(EpisodeConfig(sim=sim))
+        gated = run_episode(EpisodeConfig(sim=sim, window=TorqueFreeWindow(0.3, 1.2)))
+        assert not base.fell and not gated.fell and gated.distance_m >= 10.0
+        assert gated.cost_of_transport < 0.65 * base.cost_of_transport
+        hips = lambda r: r.positive_work_j["left_hip"] + r.positive_work_j["right_hip"]  # noqa: E731
+        assert hips(gated) / gated.distance_m < 0.65 * hips(base) / base.distance_m
 
 
 @pytest.mark.slow
 def test_the_coasting_gait_walks_with_the_hip_off_until_the_foot_lands():
     """The shipped gait `coasting`'s defining property: its swing hip off from 0.3 s after each touchdown
     until the next (t2 beyond any step), it walks 10 m and saves (measured: C_mt 0.335 -> 0.276, -18 %);
-    the default gait falls that way (at 1.5 m)."""
+    `steady` falls that way (at 1.5 m)."""
     from drake_biped.resources import load_gait
 
     coasting = load_gait("coasting")
@@ -152,7 +156,7 @@ def test_the_coasting_gait_walks_with_the_hip_off_until_the_foot_lands():
     steps = np.diff([s.touchdown_time_s for s in coast.steps])
     assert np.all(steps > 0.3)  # every step ended inside the window: the swing coasted to touchdown
     assert coast.cost_of_transport < 0.9 * base.cost_of_transport
-    assert run_episode(EpisodeConfig(window=TorqueFreeWindow(0.3, 5.0))).fell
+    assert run_episode(load_gait("steady").replace(window=TorqueFreeWindow(0.3, 5.0))).fell
 
 
 @pytest.mark.slow
@@ -256,7 +260,8 @@ def test_a_diverging_control_loop_is_named_diverged_not_a_fall():
     coarse = run_episode(EpisodeConfig().override({"sim.time_step_s": 0.01, "sim.control_period_s": 0.01,
                                                    "sim.distance_m": 1.0}))
     assert coarse.termination == "diverged" and coarse.fell
-    assert coarse.fall_reason.startswith("the control loop diverged: 5 torque reversals")
+    reversals = re.match(r"the control loop diverged: (\d+) torque reversals", coarse.fall_reason)
+    assert reversals and 5 <= int(reversals.group(1)) <= 8  # the fifth ends it; one update may add a few
     assert coarse.duration_s < 0.2  # caught within a few periods, not after a second of chattering
     parts, simulator, reason, _ = simulate(EpisodeConfig(sim=SimulationParams(distance_m=2.0, max_time_s=8.0)))
     state = parts.controller.state(parts.controller.GetMyContextFromRoot(simulator.get_context()))

@@ -51,8 +51,10 @@ def test_search_keeps_the_best_parent_and_resumes(tmp_path, client):
 
 def test_paper_mutations_hold_the_cpg_and_the_initiation():
     from drake_biped.params import InitialConditions
+    from drake_biped.resources import load_gait
 
-    c = EpisodeConfig(cpg=PAPER_CPG, initial=InitialConditions(cpg_phase_rad=1.0))
+    # steady's gains lie inside every mutation's bounds, so each one moves
+    c = load_gait("steady").replace(cpg=PAPER_CPG, initial=InitialConditions(cpg_phase_rad=1.0))
     child = mutate(c, random.Random(3), sigma=0.5, mutations=PAPER_MUTATIONS)
     assert child.cpg == PAPER_CPG
     assert (child.initial.hip_angle_rad, child.initial.speed_mps) == (c.initial.hip_angle_rad, c.initial.speed_mps)

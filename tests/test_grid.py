@@ -154,6 +154,18 @@ def test_shipped_specs_and_parameter_files_are_valid():
         for point in grid_points(load_spec(name)):
             point_config(EpisodeConfig(), point)
     assert gait_names() == ["attracting", "climbing", "climbing_2deg", "coasting", "coasting_garb", "coasting_wide",
-                            "paper", "paper_entrained"]
-    for name in ("climbing", "climbing_2deg"):  # the climbing gaits differ from the default by the grid's axes
-        assert load_gait(name).gait.torso_pitch_rad < EpisodeConfig().gait.torso_pitch_rad
+                            "paper", "paper_entrained", "steady"]
+    for name in ("climbing", "climbing_2deg"):  # the climbing gaits differ from steady by the grid's axes
+        assert load_gait(name).gait.torso_pitch_rad < load_gait("steady").gait.torso_pitch_rad
+
+
+def test_every_shipped_gait_names_all_its_gains():
+    """A section's missing fields are the default gait's, so a shipped gait file lists every CPG, gait and
+    initiation field: a change of the default gait leaves it as it was."""
+    from drake_biped.resources import gait_names, gait_path
+
+    full = EpisodeConfig().to_dict()
+    for name in gait_names():
+        data = json.loads(gait_path(name).read_text())
+        for section in ("cpg", "gait", "initial"):
+            assert set(data[section]) == set(full[section]), (name, section)

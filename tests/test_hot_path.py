@@ -198,7 +198,7 @@ def test_the_compiled_update_gives_the_numbers_of_the_same_code_run_as_python():
 @pytest.mark.parametrize("change, ending", [
     ({"window": TorqueFreeWindow(0.2, 0.5)}, "distance"),
     ({"sim": SimulationParams(distance_m=1.5, max_time_s=15.0, time_step_s=5e-4)}, "distance"),  # 2 steps a period
-    ({"push": Push(-60.0)}, "fall"),
+    ({"push": Push(-150.0)}, "fall"),
     ({"sim": SimulationParams(distance_m=1.5, max_time_s=0.8345)}, "time limit"),
 ])
 def test_stepping_the_plant_directly_gives_the_simulators_numbers(monkeypatch, change, ending):

@@ -207,6 +207,22 @@ def test_the_packaged_full_run_is_the_shipped_full_runs_verdicts():
     assert {r["key"] for r in full_run_digest()["rows"]} >= {"learn", "stability", "floquet"}
 
 
+def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
+    """A full run measured on another gait than today's default is named by its shipped gait (or "another
+    gait"), so that its column is not read as the default gait's; on the default gait, nothing is said."""
+    from drake_biped.analysis.reproduce_report import full_run_gait
+    from drake_biped.params import EpisodeConfig
+    from drake_biped.resources import load_gait
+
+    def digest(config):
+        return {"checks": {"learn": {"config": config.to_dict()}}}
+
+    assert full_run_gait(digest(EpisodeConfig())) is None
+    assert full_run_gait(digest(load_gait("steady"))) == "`steady`"
+    assert full_run_gait(digest(EpisodeConfig().override({"u_a": 2.0}))) == "another gait"
+    assert full_run_gait({"checks": {}}) is None and full_run_gait(None) is None
+
+
 @pytest.mark.slow
 def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_numbers(tmp_path):
     """The quick profile's check of the shipped full run: every learned window (and no window) re-walked

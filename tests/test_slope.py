@@ -17,7 +17,7 @@ from drake_biped.experiments.slope import (
     trial_summary,
 )
 from drake_biped.learners.garb import GarbLearner
-from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
+from drake_biped.params import ParameterError, SimulationParams
 from drake_biped.resources import load_gait
 
 
@@ -97,7 +97,7 @@ def test_slope_refuses_bad_options(tmp_path, capsys, argv, match):
 
 @pytest.mark.slow
 def test_slope_story_on_a_short_setting(tmp_path):
-    """2 m level, then 2 m up 0.02 rad. The default gait does not climb. The climbing gait found by the
+    """2 m level, then 2 m up 0.02 rad. `steady` does not climb. The climbing gait found by the
     grid search climbs without a torque-free period and falls with the 0.2-0.4 s period that saves energy
     on level ground; a rerun recomputes nothing."""
     from drake_biped.experiments.executor import dask_client
@@ -108,7 +108,8 @@ def test_slope_story_on_a_short_setting(tmp_path):
     state, source = start_from_window(0.2, 0.4, 1e-4)  # a tiny variance: samples stay at the period
     with dask_client(workers=2) as client:
         record = run_slope(tmp_path / "climbing", climbing, ground, state, source, 1, 2, 0, client)
-        default = run_slope(tmp_path / "default", EpisodeConfig(sim=sim), ground, state, source, 1, 1, 0, client)
+        steady = run_slope(tmp_path / "steady", load_gait("steady").replace(sim=sim), ground, state, source, 1, 1, 0,
+                           client)
         mtimes = {p: p.stat().st_mtime_ns for p in (tmp_path / "climbing").rglob("*.json")}
         again = run_slope(tmp_path / "climbing", climbing, ground, state, source, 1, 2, 0, client)
     checks = record["checks"]
@@ -118,7 +119,7 @@ def test_slope_story_on_a_short_setting(tmp_path):
     # ... in each of its four walks: as learned, at half the plant step, from 0.95 and 1.05 x the speed.
     assert record["rewalks"]["no_window"]["all_climb"] and record["rewalks"]["start_window"]["none_climbs"]
     assert (tmp_path / "climbing" / "checks" / "no_window.half_step.json").is_file()
-    assert not default["checks"]["no_window"]["climbs"]  # the default gait falls on the slope
+    assert not steady["checks"]["no_window"]["climbs"]  # the gait climbing was searched from falls on the slope
     assert len(record["episodes"][0]["episodes"]) == 2
     assert again["checks"] == record["checks"] and again["trials"] == record["trials"]
     for p in ("checks/no_window.json", "checks/start_window.json", "trials/trial_0.json"):

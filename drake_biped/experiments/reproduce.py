@@ -88,7 +88,7 @@ class Profile:
 # full run's learned windows walked again, a few learning episodes and one Floquet orbit. What it is too small
 # to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
 QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
-                2.0, floquet_epsilons=(1e-7, 1e-6, 1e-5), floquet_newton_iterations=5, floquet_gaits=("none",),
+                2.0, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
 # The full run: 3.3 h on 2 workers from scratch, more than half of it CMA-ES and PGPE in the learners' comparison
 # (docs/RESULTS.md, its steps counted one by one).
@@ -392,7 +392,8 @@ class Reproduction:
         from drake_biped.experiments.grid import Axis
 
         g, c = self.level.gait, self.level.cpg
-        lean = Axis("gait.torso_pitch_rad", tuple(round(g.torso_pitch_rad - d, 4) for d in SLOPE_2DEG_LEANS))
+        lean = Axis("gait.torso_pitch_rad", tuple(round(g.torso_pitch_rad - d, 4) if d else g.torso_pitch_rad
+                                                  for d in SLOPE_2DEG_LEANS))
         raised = [Axis(f"cpg.{k}", (getattr(c, k), round(SLOPE_2DEG_CPG_SCALE * getattr(c, k), 4)))
                   for k in ("u_a", "u_r", "kappa")]
         if not self.profile.slope_grid_full:
