@@ -244,8 +244,10 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append(("Table VII: CPG parameters for 2.0°", "u_a +37 %, u_r +25 %, κ +51 %", vii_changes,
                      vii_verdict))
     ts = s["time_step"]
-    verdicts.append(("Time step", "—", "chosen " + ("none" if ts["chosen_step_s"] is None
-                                                      else f"{1e3 * ts['chosen_step_s']:g} ms"), BEYOND))
+    chosen = "none" if ts["chosen_step_s"] is None else f"{1e3 * ts['chosen_step_s']:g} ms"
+    ran = _ms(s["learn"]["settings"]["config"]) if "config" in s.get("learn", {}).get("settings", {}) else None
+    verdicts.append(("Time step", "—", f"chosen {chosen}" + (f"; this run's experiments at {ran}"
+                                                              if ran is not None and ran != chosen else ""), BEYOND))
 
     summary_figure(verdicts, f"drake-biped reproduce ({profile.name}): the paper's claims, measured on one gait",
                    out / "report_summary.png")

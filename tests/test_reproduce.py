@@ -130,6 +130,10 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     # The Floquet row says of each orbit whether its multipliers establish anything.
     from drake_biped.analysis.floquet import record_verdict
 
+    # The time step row says so when the study chose another step than the one this run's experiments used.
+    chosen = summaries["time_step"]["chosen_step_s"]
+    time_row = next(row for row in table if row.startswith("| Time step"))
+    assert ("this run's experiments at 1 ms" in time_row) == (chosen != 0.001), time_row
     floquet_row = next(row for row in table if "Floquet" in row)
     for name, gait in summaries["floquet"]["gaits"].items():
         assert f"({record_verdict(gait)})" in floquet_row, name
