@@ -83,9 +83,10 @@ _count = integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
-    p.add_argument("--params", help="a shipped gait by name (attracting, climbing, climbing_2deg, coasting, "
-                   "coasting_garb, coasting_wide, paper, paper_entrained) or a JSON file of EpisodeConfig fields (cpg, gait, "
-                   "initial, ...) or a result.json")
+    from drake_biped.resources import gait_names
+
+    p.add_argument("--params", help=f"a shipped gait by name ({', '.join(gait_names())}) or a JSON file of "
+                   "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
     p.add_argument("--distance", type=number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
     p.add_argument("--max-time", type=number("positive"),
                    help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")

@@ -66,6 +66,18 @@ def test_a_partial_section_keeps_the_default_gait(tmp_path):
         EpisodeConfig.from_dict({"gait": {"bogus": 1.0}})
 
 
+def test_the_params_help_names_every_shipped_gait():
+    """`--params`' help lists the shipped gaits by name, so a gait added to drake_biped/gaits/ is offered
+    without editing the help text."""
+    from drake_biped.cli import build_parser
+    from drake_biped.resources import gait_names
+
+    walk = next(a for a in build_parser()._actions if a.dest == "command").choices["walk"]
+    text = " ".join(walk.format_help().split())
+    assert "steady" in gait_names()
+    assert all(name in text for name in gait_names())
+
+
 @pytest.mark.parametrize("argv, needle", [
     (["walk", "--distance", "-1", "--out", "x"], "'-1' must be > 0"),
     (["walk", "--distance", "nan", "--out", "x"], "'nan' is not a finite number"),
