@@ -19,6 +19,7 @@ from pathlib import Path
 from drake_biped.experiments.gait_search import OBJECTIVES
 from drake_biped.model import ModelError
 from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow
+from drake_biped.resources import gait_names, load_gait
 
 
 def number(kind: str):
@@ -83,8 +84,6 @@ _count = integer(1)
 
 
 def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
-    from drake_biped.resources import gait_names
-
     p.add_argument("--params", help=f"a shipped gait by name ({', '.join(gait_names())}) or a JSON file of "
                    "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
     p.add_argument("--distance", type=number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
@@ -128,8 +127,6 @@ CONVERGED_TIME_STEP_S = 0.002
 
 
 def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
-    from drake_biped.resources import load_gait
-
     config = EpisodeConfig() if args.params is None else load_gait(args.params)
     changes: dict[str, float] = {}
     if args.distance is not None:
@@ -227,8 +224,6 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
     if args.replot:
         rec = time_step.replot(out)
     else:
-        from drake_biped.resources import load_gait
-
         config = None if args.params is None else load_gait(args.params)
         if args.model is not None:
             config = _with_model(config or EpisodeConfig(), args.model)
