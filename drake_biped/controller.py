@@ -60,10 +60,18 @@ from drake_biped.gait import (
     touchdown_rule,
 )
 from drake_biped.jit import njit
-from drake_biped.kinematics import BODY, TABLE_I_BODY, center_of_mass_k, leg_points_k
+from drake_biped.kinematics import (
+    B_ANKLE_EFFORT,
+    B_HIP_EFFORT,
+    B_KNEE_EFFORT,
+    BODY,
+    TABLE_I_BODY,
+    center_of_mass_k,
+    leg_points_k,
+)
 from drake_biped.layout import Field, VectorLayout
 from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
-from drake_biped.params import EFFORT_LIMITS_NM, EpisodeConfig
+from drake_biped.params import EpisodeConfig
 
 # The "controller_state" discrete group, declared once; the update below uses the offsets generated here.
 CONTROLLER_STATE = VectorLayout("controller_state", (
@@ -91,8 +99,9 @@ CONTROLLER_STATE = VectorLayout("controller_state", (
                                              "first; NaN until read in this step (rad/s)"),
     Field("swing_travel_rad", 1, "integral of zeta since T_n: the swing thigh's travel under the integrated "
                                  "reading (rad)"),
-    Field("torque_reversals", 1, "times a joint's torque jumped by more than REVERSAL_FACTOR times its motor's "
-                                 "limit from one control period to the next (a diverging control loop)"),
+    Field("torque_reversals", 1, "updates at which a joint's torque jumped by more than REVERSAL_FACTOR times its "
+                                 "motor's limit from the previous control period (a diverging control loop)"),
+    Field("recent_reversals_s", 5, "the times of the last DIVERGED_REVERSALS reversals, latest first (-inf: none)"),
 ))
 N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
@@ -104,7 +113,7 @@ COM_X, TARGET_X, DONE, STATE_TIME = _o("com_x_m"), _o("target_x_m"), _o("done"),
 Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
 POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_work_j"), _o("previous_clearance_m")
 PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_rates_radps"), _o("swing_travel_rad")
-REVERSALS = _o("torque_reversals")
+REVERSALS, RECENT_REVERSALS = _o("torque_reversals"), _o("recent_reversals_s")
 del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
@@ -114,6 +123,7 @@ TOUCHDOWN = VectorLayout("touchdown", (
     Field("hip_rate_radps", 1, "its rate (rad/s)"),
     Field("stance_right", 1, "1.0 when the new stance leg is the right one"),
     Field("com_x_m", 1, "centre of mass x (m)"),
+    Field("positive_work_j", 1, "the motors' positive work since the start, all joints (J)"),
 ))
 TOUCHDOWN_FIELDS = TOUCHDOWN.names
 _TD = TOUCHDOWN.size
@@ -134,12 +144,14 @@ FALL_REASONS = {
     5: "the control loop diverged",
 }
 # A diverging control loop (a control period too long for the servos' gains: the torques chatter between their
-# limits) is told from a walk by torque reversals: a joint's torque jumping by more than REVERSAL_FACTOR times
-# its motor's limit from one period to the next. A walk has none (the default gait at 1 and 2 ms, coasting_wide,
-# climbing, paper: 0); the default gait at 5, 10 and 20 ms has 88-1208 before it falls. DIVERGED_REVERSALS of them
-# end the episode as diverged.
+# limits) is told from a walk by the rate of torque reversals: a joint's torque jumping by more than
+# REVERSAL_FACTOR times its motor's limit from one period to the next. A chattering loop reverses at nearly every
+# period; an impact or a push makes one reversal, rarely two, and a long walk may gather a few over hundreds of
+# steps. So the episode ends as diverged when DIVERGED_REVERSALS reversals fall within DIVERGENCE_SPAN_PERIODS
+# control periods (20 ms at 1 ms): a rate, not a total.
 REVERSAL_FACTOR = 1.5
 DIVERGED_REVERSALS = 5
+DIVERGENCE_SPAN_PERIODS = 20
 DIVERGED_CODE = 5
 
 
@@ -171,7 +183,6 @@ LAW = VectorLayout("law", (
     Field("ground_slope_rad", 1, ""), Field("ground_tan_slope", 1, "tan of the slope"),
     Field("ground_level_length_m", 1, "level ground before the slope (NaN: the slope everywhere)"),
     Field("fall_hip_height_m", 1, ""), Field("fall_pitch_rad", 1, ""),
-    Field("hip_limit_nm", 1, ""), Field("knee_limit_nm", 1, ""), Field("ankle_limit_nm", 1, ""),
 ))
 _o = LAW.offset
 L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("control_period_s", "state_lag_s", "alpha", "u_a",
@@ -187,7 +198,6 @@ L_ANKLE_KP, L_ANKLE_KD, L_TOUCHDOWN = _o("ankle_kp"), _o("ankle_kd"), _o("touchd
 L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_first_step")
 L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
 L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
-L_HIP_LIMIT, L_KNEE_LIMIT, L_ANKLE_LIMIT = _o("hip_limit_nm"), _o("knee_limit_nm"), _o("ankle_limit_nm")
 del _o
 
 
@@ -223,9 +233,6 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     put("ground_level_length_m", math.nan if ground.level_length_m is None else ground.level_length_m)
     put("fall_hip_height_m", sim.fall_hip_height_m)
     put("fall_pitch_rad", sim.fall_pitch_rad)
-    put("hip_limit_nm", EFFORT_LIMITS_NM["hip"])
-    put("knee_limit_nm", EFFORT_LIMITS_NM["knee"])
-    put("ankle_limit_nm", EFFORT_LIMITS_NM["ankle"])
     return v
 
 
@@ -319,7 +326,7 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
     free = 0.0
     if s[STEP_COUNT] >= law[L_FIRST_STEP]:
         free = torque_free_fraction(elapsed, dt, law[L_T1], law[L_T2])
-    hip_limit = law[L_HIP_LIMIT]
+    hip_limit = body[B_HIP_EFFORT]
     if free >= 1.0:
         tau_swing_hip = 0.0
     else:
@@ -340,10 +347,10 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
     knee_start = (gamma, q[sw_i + KNEE], swing[_THIGH])
     knee_end = (advance_phase_k(law[L_UR], law[L_KAPPA], gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
                 swing[_THIGH] + dt * swing_rate)
-    knee_limit = law[L_KNEE_LIMIT]
+    knee_limit = body[B_KNEE_EFFORT]
     s[a_sw + KNEE] = clip(swing_knee_torque_over_k(knee, knee_start, knee_end, 20), knee_limit)
     s[a_st + KNEE] = clip(-law[L_STANCE_KNEE], knee_limit)
-    ankle_limit = law[L_ANKLE_LIMIT]
+    ankle_limit = body[B_ANKLE_EFFORT]
     for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
         foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
         slope = ground_slope_k(law, leg[_ANKLE_X])
@@ -437,6 +444,9 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
         row[3] = rate
         row[4] = 1.0 if contact_right else 0.0
         row[5] = com_x
+        row[6] = 0.0
+        for i in range(6):
+            row[6] += s[POSITIVE_WORK + i]
         code |= TOUCHED
         s[CONTACT_RIGHT] = 1.0 if contact_right else 0.0
         s[STEP_START] = step_start
@@ -502,12 +512,19 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
         s[FALL] = 3.0
     if com_x >= s[TARGET_X]:
         s[DONE] = 1.0
+    reversed_ = False
     for i in range(6):
-        limit = law[L_HIP_LIMIT] if i % 3 == 0 else (law[L_KNEE_LIMIT] if i % 3 == 1 else law[L_ANKLE_LIMIT])
+        limit = body[B_HIP_EFFORT] if i % 3 == 0 else (body[B_KNEE_EFFORT] if i % 3 == 1 else body[B_ANKLE_EFFORT])
         if abs(s[TAU + i] - tau[i]) > REVERSAL_FACTOR * limit:
-            s[REVERSALS] += 1.0
+            reversed_ = True
         tau[i] = s[TAU + i]
-    if s[FALL] == 0.0 and s[REVERSALS] >= DIVERGED_REVERSALS:
+    if reversed_:  # one reversal per update, however many joints jumped
+        s[REVERSALS] += 1.0
+        for j in range(DIVERGED_REVERSALS - 1, 0, -1):
+            s[RECENT_REVERSALS + j] = s[RECENT_REVERSALS + j - 1]
+        s[RECENT_REVERSALS] = now
+    oldest = s[RECENT_REVERSALS + DIVERGED_REVERSALS - 1]
+    if s[FALL] == 0.0 and now - oldest < (DIVERGENCE_SPAN_PERIODS - 0.5) * dt:
         s[FALL] = 5.0
     if s[FALL] != 0.0:
         code |= FELL
@@ -542,6 +559,7 @@ class CpgWalkingController(LeafSystem):
         initial[TARGET_X] = math.inf
         initial[PREV_CLEARANCE] = math.inf
         initial[PREV_RATES : PREV_RATES + 2] = math.nan
+        initial[RECENT_REVERSALS : RECENT_REVERSALS + DIVERGED_REVERSALS] = -math.inf
         self._torque_group = self.DeclareDiscreteState(6)
         self._state_group = self.DeclareDiscreteState(BasicVector(initial))
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)

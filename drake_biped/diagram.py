@@ -98,7 +98,7 @@ def build_diagram(
     """
     builder = DiagramBuilder()
     handles = add_biped(builder, config.ground, config.sim.time_step_s, config.model,
-                        contact_approximation=config.sim.contact_approximation)
+                        contact_approximation=config.sim.contact_approximation, contact=config.contact)
     plant = handles.plant
     _, _, stance_right, liftoff = initial_state(config, handles.body)
     controller = builder.AddNamedSystem("cpg_controller",
@@ -146,7 +146,7 @@ def build_replay_diagram(
         raise ValueError(f"expected times (n,) and torques (n, 6), got {times.shape} and {torques.shape}")
     builder = DiagramBuilder()
     plant = add_biped(builder, config.ground, config.sim.time_step_s, config.model,
-                      contact_approximation=config.sim.contact_approximation).plant
+                      contact_approximation=config.sim.contact_approximation, contact=config.contact).plant
     breaks = np.append(times, times[-1] + config.sim.control_period_s)
     hold = PiecewisePolynomial.ZeroOrderHold(breaks, np.vstack([torques, torques[-1:]]).T)
     source = builder.AddNamedSystem("logged_torques", TrajectorySource(hold))

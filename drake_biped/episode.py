@@ -17,6 +17,7 @@ from pydrake.systems.framework import EventStatus
 
 from drake_biped import controller as ctl
 from drake_biped.analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg
+from drake_biped.analysis.long_run import BATCHES, TRANSIENT_M, long_run_cost
 from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
@@ -36,10 +37,12 @@ class StepRecord:
     hip_rate_radps: float
     stance_leg: str
     com_x_m: float
+    positive_work_j: float | None = None  # the motors' positive work from the start to this touchdown (J)
 
 
 STEP_ARRAY_DTYPE = np.dtype([("index", int), ("touchdown_time_s", float), ("hip_angle_rad", float),
-                             ("hip_rate_radps", float), ("stance_right", bool), ("com_x_m", float)])
+                             ("hip_rate_radps", float), ("stance_right", bool), ("com_x_m", float),
+                             ("positive_work_j", float)])
 
 
 @dataclass
@@ -80,7 +83,15 @@ class EpisodeResult:
         """The steps as one structured array, a row per touchdown: `touchdowns["hip_angle_rad"]` is the
         section angles, `touchdowns["touchdown_time_s"]` their times (fields: STEP_ARRAY_DTYPE)."""
         return np.array([(s.index, s.touchdown_time_s, s.hip_angle_rad, s.hip_rate_radps, s.stance_leg == "right",
-                          s.com_x_m) for s in self.steps], dtype=STEP_ARRAY_DTYPE)
+                          s.com_x_m, math.nan if s.positive_work_j is None else s.positive_work_j)
+                         for s in self.steps], dtype=STEP_ARRAY_DTYPE)
+
+    def long_run(self, transient_m: float = TRANSIENT_M, batches: int = BATCHES) -> dict:
+        """The walk's long-run C_mt after the initiation's transient, with its 95 % interval (batch means over
+        steps) and its step periods' statistics: analysis.long_run.long_run_cost on this walk's touchdowns."""
+        td = self.touchdowns
+        return long_run_cost(td["touchdown_time_s"], td["com_x_m"], td["positive_work_j"], self.mass_kg,
+                             GRAVITY_MPS2, transient_m, batches)
 
     @property
     def sections(self) -> np.ndarray:
@@ -120,7 +131,7 @@ class DiagramCache:
     episodes of a learning run or a grid search; rebuilding the diagram for each would cost a few ms and,
     with pydrake 1.51, leak ~0.4 MB per build (RobotLocomotion/drake#24529). An entry is keyed by what the
     diagram is built from: the ground, time step, control period, time limit, minimum step time, contact
-    approximation, push, robot model and recording. At most `size` entries are kept (least recently used goes first).
+    approximation and material, push, robot model and recording. At most `size` entries are kept (least recently used goes first).
     """
 
     def __init__(self, size: int = 4):
@@ -132,6 +143,7 @@ class DiagramCache:
         return (
             CpgWalkingController.structure_key(config),
             config.sim.contact_approximation,
+            config.contact,
             config.push,
             None if config.model is None else config.model.sha256,
             record,
@@ -364,8 +376,9 @@ def run_episode(
     fall_code = int(s.fall_code)
     fell = reason != "distance" and reason != "time limit"
     if reason == "diverged":
-        fall_reason = (f"the control loop diverged: {int(s.torque_reversals)} torque reversals of more than "
-                       f"{ctl.REVERSAL_FACTOR:g} x a motor's limit between control periods (the control period "
+        fall_reason = (f"the control loop diverged: {ctl.DIVERGED_REVERSALS} torque reversals of more than "
+                       f"{ctl.REVERSAL_FACTOR:g} x a motor's limit within {ctl.DIVERGENCE_SPAN_PERIODS} control "
+                       f"periods ({int(s.torque_reversals)} in all; the control period "
                        f"{config.sim.control_period_s:g} s is too long for the servos)")
     else:
         fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
@@ -427,6 +440,7 @@ def step_records(touchdowns: np.ndarray) -> list[StepRecord]:
             hip_rate_radps=float(row[2]),
             stance_leg="right" if row[3] > 0.5 else "left",
             com_x_m=float(row[4]),
+            positive_work_j=float(row[5]),
         )
         for k, row in enumerate(touchdowns)
     ]

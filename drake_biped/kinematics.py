@@ -22,7 +22,7 @@ import numpy as np
 from drake_biped.jit import njit
 from drake_biped.layout import Field, VectorLayout
 from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
-from drake_biped.params import CONTACT_RADIUS_M, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M
+from drake_biped.params import CONTACT_RADIUS_M, EFFORT_LIMITS_NM, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M
 
 THIGH_M = TABLE_I_LENGTHS_M["thigh"]
 SHANK_M = TABLE_I_LENGTHS_M["shank"]
@@ -99,6 +99,9 @@ BODY = VectorLayout("body", (
     Field("shank_kg", 1, "one shank's mass"),
     Field("foot_kg", 1, "one foot's mass"),
     Field("total_kg", 1, "the whole robot's mass"),
+    Field("hip_effort_nm", 1, "the hip motors' torque limit (the model's effort limit)"),
+    Field("knee_effort_nm", 1, "the knee motors' torque limit"),
+    Field("ankle_effort_nm", 1, "the ankle motors' torque limit"),
 ))
 _b = BODY.offset
 B_HIP_X, B_HIP_Z, B_TORSO_COM_X, B_TORSO_COM_Z = _b("hip_x_m"), _b("hip_z_m"), _b("torso_com_x_m"), _b("torso_com_z_m")
@@ -111,6 +114,7 @@ B_HEEL_X, B_HEEL_SOLE, B_HEEL_R, B_TOE_X, B_TOE_SOLE, B_TOE_R = (_b(n) for n in 
     "heel_x_m", "heel_sole_z_m", "heel_radius_m", "toe_x_m", "toe_sole_z_m", "toe_radius_m"))
 B_M_TORSO, B_M_THIGH, B_M_SHANK, B_M_FOOT, B_M_TOTAL = _b("torso_kg"), _b("thigh_kg"), _b("shank_kg"), _b("foot_kg"), \
     _b("total_kg")
+B_HIP_EFFORT, B_KNEE_EFFORT, B_ANKLE_EFFORT = _b("hip_effort_nm"), _b("knee_effort_nm"), _b("ankle_effort_nm")
 del _b
 
 
@@ -125,12 +129,13 @@ def com_on_segment(com_xz, joint_xz) -> tuple[float, float, float]:
 def body_vector(masses: LinkMasses = TABLE_I_MASSES, *, hip=(0.0, 0.0), torso_com=(0.0, 0.5 * TORSO_M),
                 knee=(0.0, -THIGH_M), thigh_com=(0.0, -0.5 * THIGH_M), ankle=(0.0, -SHANK_M),
                 shank_com=(0.0, -0.5 * SHANK_M), foot_com=FOOT_COM_M, heel=(HEEL_X_M, -SOLE_DEPTH_M, CONTACT_RADIUS_M),
-                toe=(TOE_X_M, -SOLE_DEPTH_M, CONTACT_RADIUS_M)) -> np.ndarray:
+                toe=(TOE_X_M, -SOLE_DEPTH_M, CONTACT_RADIUS_M),
+                efforts=(EFFORT_LIMITS_NM["hip"], EFFORT_LIMITS_NM["knee"], EFFORT_LIMITS_NM["ankle"])) -> np.ndarray:
     """The body (BODY layout) from its joints, centres of mass and contact spheres (x, sole z, radius), each in
-    its link's frame (defaults: the shipped model, Table I), and the masses. `model.body_of` reads them from a
-    plant."""
+    its link's frame (defaults: the shipped model, Table I), the masses and the motors' torque limits (hip,
+    knee, ankle; N*m). `model.body_of` reads them from a plant."""
     return np.array([*hip, *torso_com, *knee, *com_on_segment(thigh_com, knee), *ankle,
-                     *com_on_segment(shank_com, ankle), *foot_com, *heel, *toe, *masses], dtype=float)
+                     *com_on_segment(shank_com, ankle), *foot_com, *heel, *toe, *masses, *efforts], dtype=float)
 
 
 TABLE_I_BODY = body_vector()

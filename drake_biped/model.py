@@ -19,7 +19,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import AddContactMaterial, Box, HalfSpace, ProximityProperties, SceneGraph, Sphere
+from pydrake.geometry import (
+    AddContactMaterial,
+    Box,
+    HalfSpace,
+    ProximityProperties,
+    RoleAssign,
+    SceneGraph,
+    Sphere,
+)
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import (
@@ -37,7 +45,7 @@ from drake_biped.kinematics import (
     leg_points_k,
     link_masses,
 )
-from drake_biped.params import GRAVITY_MPS2, Ground, RobotModel
+from drake_biped.params import GRAVITY_MPS2, ContactParams, Ground, RobotModel
 from drake_biped.resources import model_package_xml
 
 MODEL_URL = "package://drake_biped/biped.urdf"
@@ -88,26 +96,56 @@ def add_biped(
     time_step_s: float,
     model: RobotModel | None = None,
     contact_approximation: str = "sap",
+    contact: ContactParams | None = None,
 ) -> PlantHandles:
     """Add the biped (`model`, or the shipped one) and the ground to `builder`, finalize the plant and read
     the controller's body from it.
 
     Contact: point contact (the heel/toe spheres against the ground half-space(s)), solved by the discrete
-    contact approximation given (SAP by default). Output ports are sampled (see controller "Timing").
+    contact approximation given (SAP by default), with the material of `contact` (params.ContactParams; its
+    defaults when None) on the foot spheres and the ground. Output ports are sampled (see controller "Timing").
     """
+    contact = contact or ContactParams()
     config = MultibodyPlantConfig(
         time_step=time_step_s,
         use_sampled_output_ports=True,
         discrete_contact_approximation=contact_approximation,
         contact_model="point",
         penetration_allowance=1e-3,
+        sap_near_rigid_threshold=contact.sap_near_rigid_threshold,
     )
     plant, scene_graph = AddMultibodyPlant(config, builder)
     parse_model(Parser(plant), model)
-    _add_ground(plant, ground)
+    _set_feet_material(plant, scene_graph, contact)
+    _add_ground(plant, ground, contact)
     plant.Finalize()
     check_layout(plant)
     return PlantHandles(plant, scene_graph, body_of(plant, scene_graph))
+
+
+_MATERIAL = (("point_contact_stiffness", "stiffness_npm"), ("relaxation_time", "relaxation_time_s"),
+             ("hunt_crossley_dissipation", "hunt_crossley_dissipation_spm"))
+
+
+def _with_material(props: ProximityProperties, contact: ContactParams) -> ProximityProperties:
+    """`props` with the material values of `contact` that are set (None leaves Drake's default)."""
+    for name, field in _MATERIAL:
+        value = getattr(contact, field)
+        if value is not None:
+            props.UpdateProperty("material", name, float(value))
+    return props
+
+
+def _set_feet_material(plant: MultibodyPlant, scene_graph: SceneGraph, contact: ContactParams) -> None:
+    """Give every collision geometry of the feet the contact's material, keeping the model's friction."""
+    inspector = scene_graph.model_inspector()
+    for name in FOOT_BODIES:
+        if not plant.HasBodyNamed(name):
+            continue  # check_layout and body_of name what is missing
+        for geometry in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(name)):
+            props = ProximityProperties(inspector.GetProximityProperties(geometry))
+            scene_graph.AssignRole(plant.get_source_id(), geometry, _with_material(props, contact),
+                                   RoleAssign.kReplace)
 
 
 def parse_model(parser: Parser, model: RobotModel | None = None) -> None:
@@ -141,8 +179,9 @@ def parse_model(parser: Parser, model: RobotModel | None = None) -> None:
 GROUND_BEHIND_M, GROUND_AHEAD_M, GROUND_DEPTH_M = -100.0, 2000.0, 10.0
 
 
-def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
-    """Ground as half-space(s) for contact plus thin boxes so Meshcat can draw it."""
+def _add_ground(plant: MultibodyPlant, ground: Ground, contact: ContactParams) -> None:
+    """Ground as half-space(s) for contact, with the contact's material, plus thin boxes so Meshcat can draw
+    it."""
     friction = CoulombFriction(ground.friction, ground.friction)
     world = plant.world_body()
 
@@ -152,12 +191,12 @@ def _add_ground(plant: MultibodyPlant, ground: Ground) -> None:
         X = RigidTransform(rotation, [through_x, 0.0, 0.0])
         props = ProximityProperties()
         AddContactMaterial(friction=friction, properties=props)
-        plant.RegisterCollisionGeometry(world, X, HalfSpace(), name, props)
+        plant.RegisterCollisionGeometry(world, X, HalfSpace(), name, _with_material(props, contact))
 
     def add_ground_box(name: str, angle: float, x0: float, x1: float) -> None:
         # A box whose top face is the ground from x0 to x1 (measured along the ground), rising at `angle` from
         # (x0, 0, 0), GROUND_DEPTH_M deep.
-        props = ProximityProperties()
+        props = _with_material(ProximityProperties(), contact)
         AddContactMaterial(friction=friction, properties=props)
         rotation = RotationMatrix.MakeYRotation(-angle)
         centre = rotation.multiply(np.array([0.5 * (x1 - x0), 0.0, -0.5 * GROUND_DEPTH_M])) + np.array([x0, 0.0, 0.0])
@@ -347,7 +386,7 @@ def body_of(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: float =
     g = legs["left"]
     body = body_vector(masses, hip=g["hip"], torso_com=_xz(plant.GetBodyByName("torso").default_com()),
                        knee=g["knee"], thigh_com=g["thigh_com"], ankle=g["ankle"], shank_com=g["shank_com"],
-                       foot_com=g["foot_com"], heel=g["heel"], toe=g["toe"])
+                       foot_com=g["foot_com"], heel=g["heel"], toe=g["toe"], efforts=motor_limits(plant))
     _check_body(plant, body, tolerance_m)
     return body
 
@@ -380,11 +419,30 @@ def effort_limits(plant: MultibodyPlant) -> np.ndarray:
     return np.array([plant.GetJointActuatorByName(f"{n}_motor").effort_limit() for n in JOINT_NAMES])
 
 
+def motor_limits(plant: MultibodyPlant) -> tuple[float, float, float]:
+    """The hip, knee and ankle motors' torque limits (N*m) of the model: the controller clips its torques to
+    them, so the torque it counts the work of is the torque the plant applies (Drake clamps the actuation to
+    these limits). ModelError naming the motor unless each is finite and positive and the legs agree."""
+    limits = dict(zip(JOINT_NAMES, effort_limits(plant)))
+    for name, value in limits.items():
+        if not (math.isfinite(value) and value > 0.0):
+            raise ModelError(f"the motor {name}_motor has the effort limit {float(value)!r} N*m; the controller needs a "
+                             "finite positive torque limit for every motor (URDF <limit effort=...>)")
+    out = []
+    for joint in JOINTS_OF_A_LEG:
+        left, right = limits[f"left_{joint}"], limits[f"right_{joint}"]
+        if left != right:
+            raise ModelError(f"the legs differ: the left {joint}'s effort limit is {left:g} N*m, the right "
+                             f"{right:g} N*m; the toolkit assumes mirror-image legs")
+        out.append(float(left))
+    return tuple(out)
+
+
 def build_plant(ground: Ground | None = None, time_step_s: float = 1e-3,
-                model: RobotModel | None = None) -> MultibodyPlant:
+                model: RobotModel | None = None, contact: ContactParams | None = None) -> MultibodyPlant:
     """A finalized plant in its own diagram builder, for inspection and tests."""
     builder = DiagramBuilder()
-    return add_biped(builder, ground or Ground(), time_step_s, model).plant
+    return add_biped(builder, ground or Ground(), time_step_s, model, contact=contact).plant
 
 
 _BODIES: dict[str | None, np.ndarray] = {}

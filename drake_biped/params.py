@@ -22,8 +22,8 @@ from drake_biped.paper import (
 )
 
 __all__ = [
-    "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
-    "SHORT_NAMES", "SimulationParams", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "ContactParams", "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
+    "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "RobotModel",
 ]
 
@@ -422,6 +422,38 @@ class SimulationParams(_Validated):
             )
 
 
+@dataclass(frozen=True)
+class ContactParams(_Validated):
+    """The contact between the feet and the ground: compliant point contact, its physical parameters explicit.
+
+    Each of the four foot spheres and the ground carries the same material (the model file's own values for
+    these three are replaced; its friction is kept). Drake combines a pair's stiffnesses in series (k/2 for two
+    equal ones) and adds their relaxation times (2 tau). The defaults are the values Drake 1.51 gives a geometry
+    that names none (measured: the same walks to the last digit): 1e6 N/m per geometry (5e5 N/m for a sphere on
+    the ground, where the robot's weight sinks one sphere 0.2 mm); a relaxation time of 0.1 s per geometry for
+    SAP's linear dissipation; a Hunt & Crossley dissipation of 50 s/m, which the "similar", "lagged" and
+    "tamsi" approximations use instead.
+
+    `sap_near_rigid_threshold` 0 turns off SAP's near-rigid regime. At Drake's default (1.0) SAP regularises
+    a contact it judges too stiff for the step by an amount that depends on the step: the contact changes when
+    the step is halved and long walks do not converge (docs/RESULTS.md, "Time step"). A field left None takes
+    Drake's default."""
+
+    stiffness_npm: float | None = 1e6
+    relaxation_time_s: float | None = 0.1
+    hunt_crossley_dissipation_spm: float | None = 50.0
+    sap_near_rigid_threshold: float = 0.0
+
+    _RANGES = {"stiffness_npm": (1e2, 1e9), "relaxation_time_s": (0.0, 10.0),
+               "hunt_crossley_dissipation_spm": (0.0, 1e3), "sap_near_rigid_threshold": (0.0, 10.0)}
+
+
+# What a record written before the contact was made explicit ran on: Drake's defaults for every material
+# value and SAP's near-rigid regime at its default threshold.
+DRAKE_DEFAULT_CONTACT = ContactParams(stiffness_npm=None, relaxation_time_s=None, hunt_crossley_dissipation_spm=None,
+                                      sap_near_rigid_threshold=1.0)
+
+
 MODEL_FORMATS = {".urdf": "urdf", ".sdf": "sdf"}
 
 
@@ -495,6 +527,7 @@ class EpisodeConfig(_Validated):
     ground: Ground = field(default_factory=Ground)
     push: Push | None = None
     sim: SimulationParams = field(default_factory=SimulationParams)
+    contact: ContactParams = field(default_factory=ContactParams)
     seed: int = 0
     # The robot: None for the shipped model (models/biped.urdf, Table I), else a user's model file.
     model: RobotModel | None = None
@@ -537,6 +570,16 @@ class EpisodeConfig(_Validated):
         return self.replace(**{k: _SECTIONS[k].from_dict(v) for k, v in sections.items()})
 
 
+def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:
+    """The EpisodeConfig of a result record's "config": as `EpisodeConfig.from_dict`, except that a record
+    written before the contact was recorded (no "contact" section) ran on DRAKE_DEFAULT_CONTACT, and is walked
+    again on it."""
+    config = EpisodeConfig.from_dict(data, where)
+    if isinstance(data, Mapping) and "contact" not in data:
+        config = config.replace(contact=DRAKE_DEFAULT_CONTACT)
+    return config
+
+
 _SECTIONS: dict[str, type] = {
     "cpg": CpgParams,
     "gait": GaitParams,
@@ -545,6 +588,7 @@ _SECTIONS: dict[str, type] = {
     "ground": Ground,
     "push": Push,
     "sim": SimulationParams,
+    "contact": ContactParams,
 }
 _SECTION_CLASSES = {cls.__name__: cls for cls in _SECTIONS.values()}
 

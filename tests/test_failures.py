@@ -310,7 +310,7 @@ def test_a_failed_drake_check_is_a_drake_failure_through_the_api_and_one_line_on
     from drake_biped import episode, model
     from drake_biped.experiments.executor import episode_task
 
-    monkeypatch.setattr(model, "_add_ground", lambda plant, ground: trigger_an_assertion_failure())
+    monkeypatch.setattr(model, "_add_ground", lambda plant, ground, contact: trigger_an_assertion_failure())
     monkeypatch.setattr(episode._CACHE, "_entries", OrderedDict())  # no diagram built before this test
     config = db.EpisodeConfig().override({"sim.distance_m": 0.3})
     for name, call in (("build_plant", lambda: db.build_plant()), ("build_diagram", lambda: db.build_diagram(config)),

@@ -367,3 +367,97 @@ def test_walk_with_a_model_file_from_another_folder(tmp_path, monkeypatch, capsy
     again = json.loads((tmp_path / "D2" / "result.json").read_text())
     assert again["cost_of_transport"] == first["cost_of_transport"]
     assert again["config"]["model"]["sha256"] == first["config"]["model"]["sha256"]
+
+
+def _hips_effort(value: str | None):
+    """An edit of the shipped URDF's text: both hips' effort limit set to `value` (None: no effort attribute)."""
+    def edit(text):
+        old = '<limit lower="-0.890118" upper="0.890118" effort="40" velocity="100"/>'
+        new = old.replace(' effort="40"', "") if value is None else old.replace('effort="40"', f'effort="{value}"')
+        return _both_legs(text, old, new)
+    return edit
+
+
+def test_the_motors_limits_are_the_models_and_the_work_is_of_the_applied_torque(tmp_path):
+    """A model whose hips are limited to 25 N*m: the controller clips to the model's limit (read from the
+    plant), so the torque the plant applies is the torque whose work is counted: the logged hip actuation never
+    exceeds 25 N*m, and the positive work integrated from the logged actuation and joint rates is the
+    episode's own."""
+    from drake_biped.episode import run_episode
+    from drake_biped.kinematics import B_HIP_EFFORT, B_KNEE_EFFORT
+    from drake_biped.model import body_of_model
+    from drake_biped.params import EpisodeConfig, RobotModel, SimulationParams
+
+    weak = RobotModel.from_file(_model_file(tmp_path, _hips_effort("25")))
+    body = body_of_model(weak)
+    assert body[B_HIP_EFFORT] == 25.0 and body[B_KNEE_EFFORT] == 30.0
+    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=10.0), model=weak),
+                    record_trajectory=True, cache=None)
+    hips = [JOINT_NAMES.index("left_hip"), JOINT_NAMES.index("right_hip")]
+    actuation = r.trajectory["actuation"]
+    assert np.max(np.abs(actuation[:, hips])) <= 25.0 + 1e-12
+    strong = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=10.0)),
+                         record_trajectory=True, cache=None)
+    assert np.max(np.abs(strong.trajectory["actuation"][:, hips])) > 25.0  # the limit binds
+    # the work of the applied torques, held over each control period, from the logged states
+    q = r.trajectory["positions"][:, 3:]
+    work = np.maximum(actuation[:-1] * np.diff(q, axis=0), 0.0).sum()
+    assert work == pytest.approx(r.total_positive_work_j, rel=0.02)
+
+
+@pytest.mark.parametrize("value, match", [
+    (None, r"the motor left_hip_motor has the effort limit inf N\*m; the controller needs a finite positive"),
+    ("0", r"the model has no actuator named 'left_hip_motor'"),  # Drake drops a zero-effort transmission
+])
+def test_a_motor_without_a_torque_limit_is_refused_by_name(tmp_path, value, match):
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_biped.params import RobotModel
+
+    model = RobotModel.from_file(_model_file(tmp_path, _hips_effort(value)))
+    with pytest.raises(ModelError, match=match):
+        add_biped(DiagramBuilder(), Ground(), 1e-3, model)
+
+
+def test_the_contact_material_is_the_configurations_on_every_foot_sphere_and_the_ground():
+    """The contact's physical parameters are explicit: each foot sphere and the ground carry the stiffness,
+    relaxation time and Hunt & Crossley dissipation of params.ContactParams, and the plant SAP's near-rigid
+    threshold; the model's friction is kept."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_biped.params import ContactParams
+
+    contact = ContactParams(stiffness_npm=2.5e5, relaxation_time_s=0.02, hunt_crossley_dissipation_spm=7.0,
+                            sap_near_rigid_threshold=0.5)
+    handles = add_biped(DiagramBuilder(), Ground(), 1e-3, contact=contact)
+    plant, inspector = handles.plant, handles.scene_graph.model_inspector()
+    geometries = [g for name in ("left_foot", "right_foot", "world")
+                  for g in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(name))]
+    assert len(geometries) == 5
+    for g in geometries:
+        props = inspector.GetProximityProperties(g)
+        assert props.GetProperty("material", "point_contact_stiffness") == 2.5e5
+        assert props.GetProperty("material", "relaxation_time") == 0.02
+        assert props.GetProperty("material", "hunt_crossley_dissipation") == 7.0
+        assert props.GetProperty("material", "coulomb_friction").dynamic_friction() == 1.0
+    assert plant.get_sap_near_rigid_threshold() == 0.5
+
+
+def test_the_default_contact_is_drakes_default_material_without_the_near_rigid_regime():
+    """ContactParams' defaults are the values Drake gives a geometry that names none (the same walk to the
+    last bit), with SAP's near-rigid regime off; a record written before the contact was recorded is walked
+    again on Drake's defaults, near-rigid regime included."""
+    from drake_biped.episode import run_episode
+    from drake_biped.params import DRAKE_DEFAULT_CONTACT, ContactParams, EpisodeConfig, SimulationParams, \
+        config_of_record
+
+    sim = SimulationParams(distance_m=1.0, max_time_s=5.0)
+    explicit = run_episode(EpisodeConfig(sim=sim), cache=None)
+    drakes = run_episode(EpisodeConfig(sim=sim, contact=ContactParams(None, None, None, 0.0)), cache=None)
+    assert explicit.cost_of_transport == drakes.cost_of_transport
+    old = EpisodeConfig(sim=sim).to_dict()
+    old.pop("contact")
+    assert config_of_record(old).contact == DRAKE_DEFAULT_CONTACT
+    assert config_of_record(EpisodeConfig(sim=sim).to_dict()).contact == ContactParams()
+    legacy = run_episode(config_of_record(old), cache=None)
+    assert legacy.cost_of_transport != explicit.cost_of_transport  # the regime changes the contact
