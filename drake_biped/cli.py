@@ -16,9 +16,10 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from drake_biped.experiments import time_step as time_step_defaults
 from drake_biped.experiments.gait_search import OBJECTIVES
 from drake_biped.model import ModelError
-from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow, with_time_step
 from drake_biped.resources import gait_names, load_gait
 
 
@@ -90,7 +91,8 @@ def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False
     p.add_argument("--max-time", type=number("positive"),
                    help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
     p.add_argument("--time-step", type=number("positive"),
-                   help="plant and control time step (s) (default: 0.001)")
+                   help="plant time step (s) (default: 0.001); the control period (1 ms) is kept, or becomes the "
+                        "step when the step is longer")
     if slope_command:
         p.add_argument("--slope", type=number("finite"), required=True,
                        help="the ascending slope after the level part (rad, > 0)")
@@ -135,7 +137,8 @@ def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     if args.max_time is not None:
         changes["sim.max_time_s"] = args.max_time
     if args.time_step is not None:
-        changes["sim.time_step_s"] = changes["sim.control_period_s"] = args.time_step
+        sim = with_time_step(config.sim, args.time_step, "--time-step")
+        changes["sim.time_step_s"], changes["sim.control_period_s"] = sim.time_step_s, sim.control_period_s
     if args.slope is not None:
         changes["ground.slope_rad"] = args.slope
     if args.level_length is not None:
@@ -227,7 +230,8 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
         config = None if args.params is None else load_gait(args.params)
         if args.model is not None:
             config = _with_model(config or EpisodeConfig(), args.model)
-        settings = time_step.TimeStepSettings(tuple(args.steps), args.reference, args.distance, config,
+        reference = min(args.steps) if args.reference is None else args.reference
+        settings = time_step.TimeStepSettings(tuple(args.steps), reference, args.distance, config,
                                               "Default gait" if args.params is None else f"Gait {args.params}",
                                               None if args.windows is None else tuple(args.windows))
         with _client(args) as client:
@@ -654,17 +658,21 @@ def build_parser() -> argparse.ArgumentParser:
     _add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 
-    ts = sub.add_parser("time-step-study", help="C_mt, speed and step period against the time step, and the default step they choose")
-    ts.add_argument("--steps", type=_steps, default=[0.00025, 0.0005, 0.001, 0.002, 0.005],
-                    help="time steps (s), comma-separated (default 0.00025,0.0005,0.001,0.002,0.005)")
-    ts.add_argument("--reference", type=number("positive"), default=0.0005, help="reference step (s), one of --steps")
-    ts.add_argument("--distance", type=number("positive"), default=10.0, help="walk this far (m); default 10")
+    ts = sub.add_parser("time-step-study", help="the long-run C_mt against the plant step (control period kept), "
+                        "Richardson's limit, and the step they choose")
+    ts.add_argument("--steps", type=_steps, default=list(time_step_defaults.STEPS),
+                    help="plant steps (s), comma-separated (default 0.002,0.001,0.0005,0.00025,0.000125)")
+    ts.add_argument("--reference", type=number("positive"), default=None,
+                    help="reference step (s), one of --steps (default: the finest)")
+    ts.add_argument("--distance", type=number("positive"), default=time_step_defaults.LONG_WALK_M,
+                    help="walk this far (m); default 110: the first 10 m are the transient, the long-run C_mt is "
+                         "over the rest")
     ts.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
                     "default gait. Its own time step is replaced by each of --steps")
     _add_model_option(ts)
     ts.add_argument("--windows", type=windows,
                     help="the windows compared with none, T1-T2 in s, comma-separated (default "
-                         "0.1-0.4,0.2-0.5,0.3-0.6,0.35-0.65,0.2-0.7)")
+                         "0.405096-0.944455,0.3-0.6: the default gait's learned window and one early in the swing)")
     _add_cluster_options(ts)
     ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
     ts.add_argument("--out", required=True, type=_out_folder, help="output folder")

@@ -23,7 +23,8 @@ from drake_biped.paper import (
 
 __all__ = [
     "ContactParams", "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
-    "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
+    "with_time_step", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "RobotModel",
 ]
 
@@ -452,6 +453,21 @@ class ContactParams(_Validated):
 # value and SAP's near-rigid regime at its default threshold.
 DRAKE_DEFAULT_CONTACT = ContactParams(stiffness_npm=None, relaxation_time_s=None, hunt_crossley_dissipation_spm=None,
                                       sap_near_rigid_threshold=1.0)
+
+
+def with_time_step(sim: SimulationParams, time_step_s: float, option: str = "time_step_s") -> SimulationParams:
+    """`sim` with the plant step `time_step_s` and its control period kept: the controller is a digital
+    controller of a fixed rate, part of the robot, not a numerical knob. A step longer than the control period
+    makes the control period the step (the controller cannot run faster than the plant is stepped).
+    ParameterError naming `option` when the control period is not a whole multiple of the step."""
+    control = sim.control_period_s
+    if time_step_s >= control:
+        control = time_step_s
+    ratio = control / time_step_s
+    if abs(ratio - round(ratio)) > 1e-6:
+        raise ParameterError(f"{option} {time_step_s!r}: the control period {control!r} s is not a whole multiple "
+                             "of it")
+    return dataclasses.replace(sim, time_step_s=time_step_s, control_period_s=control)
 
 
 MODEL_FORMATS = {".urdf": "urdf", ".sdf": "sdf"}

@@ -448,8 +448,13 @@ def test_the_default_contact_is_drakes_default_material_without_the_near_rigid_r
     last bit), with SAP's near-rigid regime off; a record written before the contact was recorded is walked
     again on Drake's defaults, near-rigid regime included."""
     from drake_biped.episode import run_episode
-    from drake_biped.params import DRAKE_DEFAULT_CONTACT, ContactParams, EpisodeConfig, SimulationParams, \
-        config_of_record
+    from drake_biped.params import (
+        DRAKE_DEFAULT_CONTACT,
+        ContactParams,
+        EpisodeConfig,
+        SimulationParams,
+        config_of_record,
+    )
 
     sim = SimulationParams(distance_m=1.0, max_time_s=5.0)
     explicit = run_episode(EpisodeConfig(sim=sim), cache=None)

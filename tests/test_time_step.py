@@ -63,7 +63,12 @@ def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
 
     def fake_map(client, fn, items, progress=None):
         seen.extend(items)
-        return [{"fell": False, "distance_m": 10.0, "cost_of_transport": 0.5 - c["window"]["end_s"] / 10,
+        def steps(cmt):  # 100 steps of 0.4 s and 0.3 m from 10 m on, each costing cmt
+            return [{"touchdown_time_s": 0.4 * k, "com_x_m": 0.3 * k,
+                     "positive_work_j": cmt * 10.0 * 9.81 * 0.3 * k} for k in range(140)]
+
+        return [{"fell": False, "distance_m": 10.0, "termination": "distance", "mass_kg": 10.0,
+                 "cost_of_transport": 0.6, "steps": steps(0.5 - c["window"]["end_s"] / 10),
                  "mean_speed_mps": 1.0, "step_period_s": 0.4, "real_time_factor": 5.0} for c in items]
 
     monkeypatch.setattr(time_step, "map_ordered", fake_map)

@@ -46,7 +46,7 @@ from drake_biped.paper import (
     LEARNING_TRIALS,
     TABLE_II,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, config_of_record
 from drake_biped.records import read_json, write_atomic
 from drake_biped.versions import versions
 
@@ -488,7 +488,7 @@ def rewalk_record(source: Path, client) -> dict[str, Any]:
     were made from."""
     record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
     try:
-        config = EpisodeConfig.from_dict(record["settings"]["config"])
+        config = config_of_record(record["settings"]["config"])
         learned = [{"trial": int(t["trial"]), "t1": float(t["final_mean"][0]), "t2": float(t["final_mean"][1])}
                    for t in record["trials"]]
     except (KeyError, TypeError, ValueError, IndexError) as exc:

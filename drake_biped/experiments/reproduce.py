@@ -39,7 +39,14 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.paper import SLOPE_RAD
-from drake_biped.params import PAPER_CPG, EpisodeConfig, InitialConditions, ParameterError, TorqueFreeWindow
+from drake_biped.params import (
+    PAPER_CPG,
+    EpisodeConfig,
+    InitialConditions,
+    ParameterError,
+    TorqueFreeWindow,
+    config_of_record,
+)
 from drake_biped.records import read_json, read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
@@ -217,7 +224,7 @@ class Reproduction:
         def run(folder: Path) -> dict:
             jobs, wanted = {}, {}
             for key, check in digest["checks"].items():
-                base = EpisodeConfig.from_dict(check["config"])
+                base = config_of_record(check["config"])
                 rows = [(0.0, 0.0, check["no_window"])] + [(r["t1"], r["t2"], r["cost_of_transport"])
                                                            for r in check["learned"]]
                 for t1, t2, recorded in rows:  # trials that ended on the same window are one walk

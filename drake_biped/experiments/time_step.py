@@ -1,29 +1,38 @@
-"""Time-step study: C_mt, speed and step period of a gait (the default one unless given), with no window
-and with a set of windows (the default gait's acceptance windows unless given), against the plant (and
-control) time step. The default step is the largest whose
-C_mt stays within 2 % of the 0.5 ms reference for every walk that walks at the reference step.
+"""Time-step study: the convergence of a gait's long-run cost of transport as the plant step is halved.
 
-`drake-biped time-step-study --out DIR` (or `python benchmarks/time_step_study.py --out DIR`) writes
-DIR/time_step_study.json (every episode, versions), .md and .png. As with `drake-biped walk --time-step`,
-the controller runs at the time step. Episodes run on Dask (a LocalCluster, or a scheduler's address).
+Each walk (no window and each window given; by default the default gait's learned window and a window early
+in the swing) goes LONG_WALK_M from the paper's initiation at every plant step, the control period kept (the
+controller is part of the robot; a step longer than it makes the control period the step). A walk's C_mt is
+its long-run mean after the initiation's transient (analysis.long_run: the first 10 m dropped, the next 100 m
+measured, with a 95 % interval from batch means). From the three finest steps, a Richardson estimate gives
+each walk's limit as the step goes to 0 and each step's error. The shipped step is the coarsest whose long-run
+C_mt, for every walk that walks at the finest step, is within TOLERANCE of it (and every finer step too).
+
+`drake-biped time-step-study --out DIR` writes DIR/time_step_study.json (every episode, versions), .md and
+.png. Episodes run on Dask (a LocalCluster, or a scheduler's address).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_cost
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, TorqueFreeWindow, with_time_step
 from drake_biped.records import read_json, save_figure, write_text_atomic
 from drake_biped.versions import versions
 
-WALKS = [None, (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7)]
-TOLERANCE = 0.02
+# The default gait's learned window (its Experiment 1, trial 4's mean) and a window early in the swing.
+WALKS = [None, (0.405096, 0.944455), (0.3, 0.6)]
+TOLERANCE = 0.01
+LONG_WALK_M = TRANSIENT_M + LONG_RUN_M
+STEPS = (0.002, 0.001, 0.0005, 0.00025, 0.000125)
 
 
 def label(window) -> str:
@@ -37,7 +46,7 @@ def study(steps: list[float], reference: float, distance: float, client, progres
     jobs = []
     for h in steps:
         for w in walk_list:
-            sim = dataclasses.replace(base.sim, time_step_s=h, control_period_s=h, distance_m=distance,
+            sim = dataclasses.replace(with_time_step(base.sim, h, "--steps"), distance_m=distance,
                                       max_time_s=max(base.sim.max_time_s, 6.0 * distance))
             window = TorqueFreeWindow(*w) if w else TorqueFreeWindow(0.0, 0.0)
             jobs.append((h, w, base.replace(sim=sim, window=window).to_dict()))
@@ -46,20 +55,64 @@ def study(steps: list[float], reference: float, distance: float, client, progres
     with tqdm(total=len(jobs), desc="time-step study", unit="episode", disable=not progress) as bar:
         results = map_ordered(client, episode_task, [j[2] for j in jobs], lambda n, r: bar.update(1))
     rows = []
-    for (h, w, _), r in zip(jobs, results):
+    for (h, w, c), r in zip(jobs, results):
+        long_run = _long_run(r)
         rows.append({
             "time_step_s": h,
+            "control_period_s": c["sim"]["control_period_s"],
             "window": list(w) if w else None,
             "walked": not r["fell"] and r["distance_m"] >= distance - 1e-6,
+            "termination": r["termination"],
             "distance_m": r["distance_m"],
-            "cost_of_transport": r["cost_of_transport"],
+            "episode_cost_of_transport": r["cost_of_transport"],
+            "cost_of_transport": long_run["cost_of_transport"],
+            "half_width": long_run["half_width"],
+            "long_run": long_run,
             "mean_speed_mps": r["mean_speed_mps"],
-            "step_period_s": r["step_period_s"],
+            "step_period_s": long_run["step_period_mean_s"],
             "real_time_factor": r["real_time_factor"],
         })
-    return {"steps": steps, "reference_s": reference, "distance_m": distance, "tolerance": TOLERANCE,
-            "walks": [list(w) if w else None for w in walk_list], "config": base.to_dict(),
-            "rows": rows, **choose_step(rows, steps, reference, TOLERANCE)}
+    rec = {"steps": steps, "reference_s": reference, "distance_m": distance, "tolerance": TOLERANCE,
+           "walks": [list(w) if w else None for w in walk_list], "config": base.to_dict(), "rows": rows,
+           **choose_step(rows, steps, reference, TOLERANCE)}
+    rec["richardson"] = {json.dumps(w): richardson(rows, steps, w) for w in rec["walks"]}
+    return rec
+
+
+def _long_run(result: dict) -> dict:
+    """analysis.long_run.long_run_cost of an episode's record (its touchdowns)."""
+    steps = result["steps"]
+    work = [math.nan if s.get("positive_work_j") is None else s["positive_work_j"] for s in steps]
+    return long_run_cost([s["touchdown_time_s"] for s in steps], [s["com_x_m"] for s in steps], work,
+                         result["mass_kg"], GRAVITY_MPS2)
+
+
+def richardson(rows: list[dict], steps: list[float], window) -> dict:
+    """Richardson's estimate of a walk's long-run C_mt as the step goes to 0, from its three finest steps
+    (h, h/2, h/4 when the steps halve): the observed order p = log2((C_h - C_h/2) / (C_h/2 - C_h/4)) where the
+    two differences share a sign and 0.5 <= p <= 3, else p = 1 (SAP's first-order step); the limit
+    C_h/4 + (C_h/4 - C_h/2) / (2^p - 1); each step's error C_h / limit - 1. None where a walk falls or the
+    finest three do not halve."""
+    by = {r["time_step_s"]: r for r in rows if tuple(r["window"] or ()) == tuple(window or ())}
+    fine = sorted(steps)[:3]
+    out = {"order": None, "order_observed": False, "limit": None, "errors": {}}
+    if len(fine) < 3 or any(abs(fine[i + 1] / fine[i] - 2.0) > 1e-9 for i in range(2)):
+        return out
+    values = [by[h]["cost_of_transport"] if by[h]["walked"] else None for h in fine]
+    if any(v is None for v in values):
+        return out
+    c4, c2, c1 = values  # h/4, h/2, h
+    d_coarse, d_fine = c1 - c2, c2 - c4
+    p = 1.0
+    if d_fine != 0.0 and d_coarse * d_fine > 0.0:
+        observed = math.log2(d_coarse / d_fine)
+        if 0.5 <= observed <= 3.0:
+            p, out["order_observed"] = observed, True
+    limit = c4 + (c4 - c2) / (2.0 ** p - 1.0)
+    out.update(order=p, limit=limit,
+               errors={f"{h:g}": (by[h]["cost_of_transport"] / limit - 1.0
+                                  if by[h]["walked"] and by[h]["cost_of_transport"] else None) for h in steps})
+    return out
 
 
 def _walks_of(rec: dict) -> list:
@@ -74,13 +127,13 @@ def choose_step(rows: list[dict], steps: list[float], reference: float, toleranc
     (relative to the same walk at the reference step, None when either fell). A walk that falls at the
     reference has no reference C_mt: it is listed in "not_judged". A step passes when every judged walk
     walks there with |deviation| <= tolerance. The chosen step is the largest one at or above the
-    reference such that it and every step between it and the reference pass; finer steps are shown as a
-    convergence check of the reference itself.
+    reference (the finest step, by default) such that it and every step between it and the reference pass.
     """
     ref = {tuple(r["window"] or ()): r for r in rows if r["time_step_s"] == reference}
     for r in rows:
         base = ref.get(tuple(r["window"] or ()))
-        ok = r["walked"] and base is not None and base["walked"]
+        ok = (r["walked"] and base is not None and base["walked"] and r["cost_of_transport"] is not None
+              and base["cost_of_transport"] is not None)
         r["cmt_deviation"] = (r["cost_of_transport"] / base["cost_of_transport"] - 1.0) if ok else None
     judged = {key for key, r in ref.items() if r["walked"]}
     passing = [h for h in steps
@@ -110,36 +163,59 @@ def markdown(rec: dict) -> str:
 
     def cmt(r):
         if not r["walked"]:
-            return f"fell at {r['distance_m']:.1f} m"
+            return f"{r['termination']} at {r['distance_m']:.1f} m"
+        if r["cost_of_transport"] is None:
+            return "too short"
         dev = r["cmt_deviation"]
         mark = "" if dev is None or abs(dev) <= rec["tolerance"] else " ✗"
-        return f"{r['cost_of_transport']:.4f} ({signed_percent(dev)}){mark}" if dev is not None else f"{r['cost_of_transport']:.4f}"
+        text = f"{r['cost_of_transport']:.4f} ± {r['half_width']:.4f}"
+        return f"{text} ({signed_percent(dev)}){mark}" if dev is not None else text
 
     chosen = rec["chosen_step_s"]
+    rich = rec.get("richardson", {})
+    rich_lines = ["| walk | limit (h → 0) | order | " + " | ".join(f"error at {h * 1e3:g} ms" for h in steps) + " |",
+                  "|---|---|---" + "|---" * len(steps) + "|"]
+    for w in _walks_of(rec):
+        e = rich.get(json.dumps(list(w) if w else None), {})
+        if not e or e.get("limit") is None:
+            rich_lines.append(f"| {label(w)} | — | — |" + " — |" * len(steps))
+            continue
+        order = f"{e['order']:.2f}" + ("" if e["order_observed"] else " (assumed)")
+        errs = [signed_percent(e["errors"].get(f"{h:g}"), 2) for h in steps]
+        rich_lines.append(f"| {label(w)} | {e['limit']:.4f} | {order} | " + " | ".join(errs) + " |")
+    control = sorted({(r["time_step_s"], r.get("control_period_s")) for r in rec["rows"]})
     lines = [
-        "# Time-step study",
+        "# Time-step study: the long-run cost of transport as the plant step is halved",
         "",
-        f"{rec.get('gait', 'Default gait')}, {rec['distance_m']:g} m walks from the paper's initiation; plant and controller at the time "
-        f"step; reference {rec['reference_s'] * 1e3:g} ms. Commit {rec['versions']['git_commit']}, "
+        f"{rec.get('gait', 'Default gait')}, {rec['distance_m']:g} m walks from the paper's initiation; C_mt is the "
+        f"long-run mean after the first {TRANSIENT_M:g} m, with its 95 % interval (batch means over steps); "
+        f"reference {rec['reference_s'] * 1e3:g} ms. Control period at each step: "
+        + ", ".join(f"{h * 1e3:g} ms → {c * 1e3:g} ms" for h, c in control if c is not None)
+        + f". Contact: {_contact_text(rec['config'])}. Commit {rec['versions']['git_commit']}, "
         f"Drake {rec['versions']['drake']}, {rec['date']}.",
         "",
-        f"**Chosen step: {chosen * 1e3:g} ms**, the largest with the C_mt of every walk that walks at the "
-        f"reference within {100 * rec['tolerance']:g} % of it." if chosen else
+        f"**Chosen step: {chosen * 1e3:g} ms**, the coarsest with the long-run C_mt of every walk that walks at "
+        f"the reference within {100 * rec['tolerance']:g} % of it (and every finer step too)." if chosen else
         "**No step passes** the tolerance for every walk.",
         "",
         *([f"Not judged (they fall at the reference step): {', '.join(label(w) for w in rec['not_judged'])}.", ""]
           if rec["not_judged"] else []),
-        "## C_mt (change from the reference)",
+        "## Long-run C_mt ± 95 % (change from the reference)",
         "",
         *table(cmt),
         "",
-        "## Speed (m/s)",
+        "## Richardson's estimate from the three finest steps",
         "",
-        *table(lambda r: f"{r['mean_speed_mps']:.3f}" if r["walked"] else "—"),
+        *rich_lines,
         "",
-        "## Step period (s)",
+        "## The episode's C_mt (whole walk, initiation included)",
         "",
-        *table(lambda r: f"{r['step_period_s']:.3f}" if r["walked"] and r["step_period_s"] else "—"),
+        *table(lambda r: f"{r['episode_cost_of_transport']:.4f}" if r.get("episode_cost_of_transport") else "—"),
+        "",
+        "## Step period after the transient (mean ± standard deviation, s)",
+        "",
+        *table(lambda r: (f"{r['long_run']['step_period_mean_s']:.4f} ± {r['long_run']['step_period_std_s']:.4f}"
+                          if r.get("long_run") and r["long_run"]["step_period_mean_s"] else "—")),
         "",
         "## Real-time factor",
         "",
@@ -147,6 +223,14 @@ def markdown(rec: dict) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+def _contact_text(config: dict) -> str:
+    c = config.get("contact")
+    if c is None:
+        return "Drake's defaults with the near-rigid regime on (a record from before the contact was recorded)"
+    return (f"{c['stiffness_npm']:g} N/m, relaxation time {c['relaxation_time_s']:g} s per geometry, SAP's "
+            f"near-rigid threshold {c['sap_near_rigid_threshold']:g}")
 
 
 def figure(rec: dict, path: Path) -> None:
@@ -170,8 +254,8 @@ def figure(rec: dict, path: Path) -> None:
     ax.set_xticks(steps_ms, [f"{x:g}" for x in steps_ms])
     ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
     ax.set_xlabel("time step (ms)")
-    ax.set_ylabel(f"C_mt change from {rec['reference_s'] * 1e3:g} ms (%)")
-    ax.set_title("Time-step study (×: a fall; grey: ±2 %)")
+    ax.set_ylabel(f"long-run C_mt change from {rec['reference_s'] * 1e3:g} ms (%)")
+    ax.set_title(f"Time-step study (×: a fall; grey: ±{100 * rec['tolerance']:g} %)")
     ax.legend(fontsize=7)
     fig.tight_layout()
     save_figure(fig, path, dpi=120)
@@ -184,9 +268,9 @@ class TimeStepSettings:
     default one; its own time step is replaced by each of `steps`), its name for the report, and the
     windows (t1, t2) compared with none (None: those of WALKS)."""
 
-    steps: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.005)
-    reference_s: float = 0.0005
-    distance_m: float = 10.0
+    steps: tuple[float, ...] = STEPS
+    reference_s: float = min(STEPS)
+    distance_m: float = LONG_WALK_M
     config: EpisodeConfig | None = None
     gait: str = "Default gait"
     windows: tuple[tuple[float, float], ...] | None = None
