@@ -24,6 +24,21 @@ REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
     "reproduced", "partly reproduced", "not reproduced", "differs", "beyond the paper")
 
 
+
+def _n(force) -> str:
+    """A margin in N, or — where none was measured."""
+    return "—" if force is None else f"{force:.0f}"
+
+
+def _margin_method(settings: dict) -> str:
+    """How a push-margin step measured its margins, from its settings."""
+    if "force_step_n" in settings:
+        return (f"Pushes of 0.1 s in steady state (12 phases of the first step after 5 s of a "
+                f"{settings['distance_m']:g} m walk) on a grid {settings['force_step_n']:g} N apart up to 100 N; the "
+                "margin is the largest force at and below which every phase survives (the paper pushes ±20 N):")
+    return (f"The largest push over 0.1 s from 0.4 s after which the gait still walks {settings['distance_m']:g} m, "
+            f"by bisection to {settings['tolerance_n']:g} N from 200 N (the paper pushes ±20 N):")
+
 def _pct(x: float | None) -> str:
     if x is None:
         return "—"
@@ -227,9 +242,9 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append((f"Table VI: stable under ±20 N, none vs the learned window ({wtext})", "all stable", stab_ours,
                      stab_verdict))
     m = s["push_margin"]["margins"]
-    verdicts.append(("Push margins (forward / backward)", "survives ±20 N", f"none {m['without']['forward']:.0f} / "
-                     f"{m['without']['backward']:.0f} N, {wtext} {m['with']['forward']:.0f} / "
-                     f"{m['with']['backward']:.0f} N", BEYOND))
+    verdicts.append(("Push margins (forward / backward)", "survives ±20 N", f"none {_n(m['without']['forward'])} / "
+                     f"{_n(m['without']['backward'])} N, {wtext} {_n(m['with']['forward'])} / "
+                     f"{_n(m['with']['backward'])} N", BEYOND))
     fl = s["floquet"]["gaits"]
     verdicts.append(("Full-state Floquet multipliers (periodic orbit, through Drake)", "—",
                      ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
@@ -333,13 +348,12 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         embed(_read(out, "stability/report.md"), "stability"),
         "### Push margins (`push_margin/`)",
         "",
-        f"The largest push over 0.1 s from 0.4 s after which the gait still walks {s['push_margin']['settings']['distance_m']:g} m, by "
-        f"bisection to {s['push_margin']['settings']['tolerance_n']:g} N from 200 N (the paper pushes ±20 N):",
+        _margin_method(s["push_margin"]["settings"]),
         "",
         "| | forward (N) | backward (N) |",
         "|---|---|---|",
-        f"| no torque-free period | {m['without']['forward']:.0f} | {m['without']['backward']:.0f} |",
-        f"| the learned window, {wtext} | {m['with']['forward']:.0f} | {m['with']['backward']:.0f} |",
+        f"| no torque-free period | {_n(m['without']['forward'])} | {_n(m['without']['backward'])} |",
+        f"| the learned window, {wtext} | {_n(m['with']['forward'])} | {_n(m['with']['backward'])} |",
         "",
         "### The periodic orbit and its Floquet multipliers (`floquet/`)",
         "",

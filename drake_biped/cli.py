@@ -378,13 +378,17 @@ def cmd_rewalk(args: argparse.Namespace) -> int:
 def cmd_push_margin(args: argparse.Namespace) -> int:
     from drake_biped.experiments import push_margin
 
-    settings = push_margin.PushMarginSettings(_episode_config(args), _chosen_window(args),
-                                              max_force_n=args.max_force, tolerance_n=args.tolerance)
+    config = _episode_config(args)
+    if args.distance is None:  # a push at --settle s (about 6 m), then room to recover or fall
+        config = config.override({"sim.distance_m": 12.0, "sim.max_time_s": max(config.sim.max_time_s, 72.0)})
+    settings = push_margin.PushMarginSettings(config, _chosen_window(args), max_force_n=args.max_force,
+                                              force_step_n=args.force_step, phases=args.phases,
+                                              settle_s=args.settle, force=args.force)
     out = Path(args.out)
     with _client(args) as client:
         push_margin.run(settings, out, client)
     print((out / "push_margin.md").read_text())
-    print(f"wrote {out}/push_margin.json, push_margin.md")
+    print(f"wrote {out}/push_margin.json, push_margin.md, push_margin.png")
     return 0
 
 
@@ -512,7 +516,7 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
     p.add_argument("--force", action="store_true",
                    help="run what is refused as beyond this machine: more --workers than its limit, a grid "
-                   "over its point limit")
+                   "over its point limit, a push-margin map over its episode limit")
 
 
 def _add_resumable_run_options(p: argparse.ArgumentParser) -> None:
@@ -729,12 +733,16 @@ def build_parser() -> argparse.ArgumentParser:
     _add_resumable_run_options(stab)
     stab.set_defaults(func=cmd_stability)
 
-    pm = sub.add_parser("push-margin", help="the largest forward and backward push the gait survives, "
-                        "with and without a torque-free period (bisection, on Dask)")
+    pm = sub.add_parser("push-margin", help="pushes in steady state over a grid of forces and phases of the step, "
+                        "with and without a torque-free period: the survival map and the margins (on Dask)")
     _add_episode_options(pm)
     _add_window_options(pm)
-    pm.add_argument("--max-force", type=number("positive"), default=200.0, help="largest push tried (N); default 200")
-    pm.add_argument("--tolerance", type=number("positive"), default=1.0, help="bisection tolerance (N); default 1")
+    pm.add_argument("--max-force", type=number("positive"), default=100.0, help="largest push tried (N); default 100")
+    pm.add_argument("--force-step", type=number("positive"), default=5.0,
+                    help="spacing of the force grid (N); default 5")
+    pm.add_argument("--phases", type=_count, default=12, help="phases of the step pushed; default 12")
+    pm.add_argument("--settle", type=number("positive"), default=5.0,
+                    help="the step pushed is the first to start at or after this time (s); default 5")
     _add_cluster_options(pm)
     pm.add_argument("--out", required=True, type=_out_folder, help="output folder")
     pm.set_defaults(func=cmd_push_margin)

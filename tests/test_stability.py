@@ -140,40 +140,52 @@ def test_a_rerun_recomputes_nothing(tmp_path):
     assert json.dumps(first["cells"], sort_keys=True) == json.dumps(again["cells"], sort_keys=True)
 
 
-class _ThresholdClient:
-    """Stands in for a Dask client: an episode survives when its push is below a threshold per cell."""
+def test_push_margin_is_the_largest_force_every_phase_survives_however_survival_varies(monkeypatch):
+    """A survival that is not monotone in the force (the backward push without the window falls at 20-25 N at
+    one phase only, and survives again above): the margin is the largest grid force at and below which every
+    phase survives, every force of the grid is walked at every phase, and the pushes land in the first step
+    that starts after the settling time, at its phases."""
+    from drake_biped.experiments import executor, push_margin
 
-    def __init__(self, limits):
-        self.limits = limits
-        self.calls = 0
+    def fake_map(client, fn, items, progress=None):
+        out = []
+        for c in items:
+            steps = [{"touchdown_time_s": 0.43 * k} for k in range(30)]
+            push = c["push"]
+            cond = "with" if c["window"]["end_s"] > c["window"]["start_s"] else "without"
+            fell = False
+            if push is not None:
+                f, start = push["force_n"], push["start_s"]
+                phase = round((start - 5.16) / 0.43 * 4) if start >= 5.16 else -1
+                assert 0 <= phase < 4, start
+                if cond == "without" and f < 0 and 20 <= -f <= 25 and phase == 2:
+                    fell = True
+                if cond == "with" and f > 0 and f >= 35:
+                    fell = True
+            out.append({"fell": fell, "distance_m": 3.0 if fell else 12.0, "steps": steps})
+        return out
 
-    def submit(self, fn, config, pure=False):
-        self.calls += 1
-        force = config["push"]["force_n"]
-        cell = ("with" if config["window"]["end_s"] > config["window"]["start_s"] else "without",
-                "forward" if force > 0 else "backward")
-        fell = abs(force) > self.limits[cell]
-        return {"fell": fell, "distance_m": 2.0 if fell else 10.0, "fall_reason": "pitch" if fell else ""}
+    monkeypatch.setattr(executor, "map_ordered", fake_map)
+    settings = push_margin.PushMarginSettings(EpisodeConfig().override({"sim.distance_m": 12.0}), (0.2, 0.5),
+                                              max_force_n=40.0, force_step_n=5.0, phases=4, settle_s=5.0)
+    assert settings.forces == [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0] and settings.episodes == 128
+    record = push_margin.push_margin(settings, client=None)
+    m = record["margins"]
+    assert m["without"]["step_s"] == pytest.approx([5.16, 5.59])  # the first step to start at or after 5 s
+    assert m["without"]["backward"]["margin_n"] == 15.0 and m["without"]["forward"]["margin_n"] == 40.0
+    assert m["without"]["backward"]["survived"][-1] == [True] * 4  # survives again above the margin
+    assert m["with"]["forward"]["margin_n"] == 30.0 and m["with"]["backward"]["margin_n"] == 40.0
+    assert push_margin.margin_of([5.0, 10.0], [[False, True], [True, True]]) == 0.0
+    text = push_margin.markdown(record)
+    assert "the first above the margin: 20 N at phase 2/4" in text
 
-    def gather(self, futures):
-        return futures
 
+def test_a_push_margin_map_beyond_its_limit_is_refused_before_any_work():
+    from drake_biped.experiments.push_margin import PushMarginSettings
 
-def test_push_margin_brackets_each_threshold_within_the_tolerance():
-    from drake_biped.experiments.push_margin import push_margin
-
-    limits = {("without", "forward"): 37.3, ("without", "backward"): 61.0,
-              ("with", "forward"): 12.25, ("with", "backward"): 250.0}
-    client = _ThresholdClient(limits)
-    out = push_margin(EpisodeConfig(), (0.2, 0.5), client, max_force_n=200.0, tolerance_n=0.5)
-    for (condition, direction), limit in limits.items():
-        m = out["margins"][condition][direction]
-        if limit >= 200.0:
-            assert m["survived_n"] == 200.0 and m["fell_n"] is None
-        else:
-            assert m["survived_n"] <= limit < m["fell_n"] and m["fell_n"] - m["survived_n"] <= 0.5
-            assert m["impulse_ns"] == pytest.approx(0.1 * m["survived_n"])
-    assert client.calls <= 4 * (1 + math.ceil(math.log2(200 / 0.5)))
+    with pytest.raises(ParameterError, match=r"push margin: 8000 pushed walks .* above 5000; .*--force"):
+        PushMarginSettings(max_force_n=100.0, force_step_n=1.0, phases=20)
+    assert PushMarginSettings(max_force_n=100.0, force_step_n=1.0, phases=20, force=True).episodes == 8000
 
 
 class _Done:

@@ -1,5 +1,15 @@
-"""Push margins: the largest forward and backward push the gait survives, with and without a torque-free
-period, by bisection on Dask (beyond the paper, which pushes with 20 N only)."""
+"""Push margins measured in steady state: a survival map over push force and the phase of the step, without
+and with a torque-free period, and the margin read from it (beyond the paper, which pushes with 20 N only).
+
+Survival is not monotone in the force (a push may fall at 60 N and be survived at 90 N), so the margin is not
+bisected: every force of a grid (`force_step_n` apart, up to `max_force_n`) is applied in each direction at
+`phases` phases of one steady-state step, each push for `push_duration_s`. The step: the first whole step that
+starts at or after `settle_s` in the unpushed walk of the same condition (after the initiation's transient;
+with the window acting, since it acts from the first touchdown on). A push at phase p starts at
+T_k + p (T_k+1 - T_k). A pushed walk survives when it still walks its whole distance. The margin of a
+condition and direction is the largest grid force at and below which every force survives at every phase
+(0 when the smallest falls somewhere).
+"""
 
 from __future__ import annotations
 
@@ -10,110 +20,214 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.experiments.stability import CONDITIONS, condition_window, survives
-from drake_biped.paper import PUSH_DURATION_S, PUSH_START_S
+from drake_biped.paper import PUSH_DURATION_S
 from drake_biped.params import EpisodeConfig, ParameterError, Push
-from drake_biped.records import write_atomic, write_text_atomic
+from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["PushMarginSettings", "markdown", "push_margin", "run"]
+__all__ = ["PushMarginSettings", "margin_of", "markdown", "push_margin", "run"]
+
+# At most this many pushed walks without --force.
+MAX_EPISODES = 5000
 
 
 @dataclass(frozen=True)
 class PushMarginSettings:
-    """The gait, the torque-free period compared with none, and the bisection's range and tolerance."""
+    """The gait, the torque-free period compared with none, the force grid, the phases and the timing."""
 
-    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 12.0}))
     window: tuple[float, float] = (0.2, 0.5)
-    max_force_n: float = 200.0
-    tolerance_n: float = 1.0
-    push_start_s: float = PUSH_START_S
+    max_force_n: float = 100.0
+    force_step_n: float = 5.0
+    phases: int = 12
+    settle_s: float = 5.0
     push_duration_s: float = PUSH_DURATION_S
+    force: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("max_force_n", "force_step_n", "settle_s", "push_duration_s"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ParameterError(f"push margin: {name} must be a positive number, got {value!r}")
+        if self.force_step_n > self.max_force_n:
+            raise ParameterError(f"--force-step {self.force_step_n:g} is above --max-force {self.max_force_n:g}")
+        if not isinstance(self.phases, int) or isinstance(self.phases, bool) or self.phases < 1:
+            raise ParameterError(f"--phases must be an integer >= 1, got {self.phases!r}")
+        if self.episodes > MAX_EPISODES and not self.force:
+            raise ParameterError(f"push margin: {self.episodes} pushed walks ({len(self.forces)} forces x 2 "
+                                 f"directions x {self.phases} phases x 2 conditions) is above {MAX_EPISODES}; "
+                                 "coarsen --force-step or --phases, or give --force")
+        if self.settle_s + 2.0 >= self.config.sim.max_time_s:
+            raise ParameterError(f"--settle {self.settle_s:g} s leaves no time to walk on before the time limit "
+                                 f"{self.config.sim.max_time_s:g} s")
+
+    @property
+    def forces(self) -> list[float]:
+        n = int(math.floor(self.max_force_n / self.force_step_n + 1e-9))
+        return [round(self.force_step_n * k, 9) for k in range(1, n + 1)]
+
+    @property
+    def episodes(self) -> int:
+        return 2 * len(self.forces) * 2 * self.phases
 
 
-def push_margin(base: EpisodeConfig, window: tuple[float, float], client, max_force_n: float = 200.0,
-                tolerance_n: float = 1.0, push_start_s: float = 0.4, push_duration_s: float = 0.1,
-                progress: Callable[[int], None] | None = None) -> dict[str, Any]:
-    """The largest forward and backward push (N over `push_duration_s`, from `push_start_s`) after which the
-    gait still walks its distance, without and with the torque-free period `window`, by bisection.
+def steady_step(result: dict[str, Any], settle_s: float) -> tuple[float, float] | None:
+    """(T_k, T_k+1): the first whole step of an unpushed walk that starts at or after `settle_s`."""
+    times = [s["touchdown_time_s"] for s in result["steps"]]
+    for a, b in zip(times, times[1:]):
+        if a >= settle_s:
+            return a, b
+    return None
 
-    Four bisections (condition x direction) advance together, one round of four episodes at a time. Each
-    assumes survival is monotonic in the force between 0 and `max_force_n`; the record keeps every episode
-    tried, so a non-monotonic case shows. The margin is the largest force that survived (its bracket's
-    upper end is the smallest that fell, or `max_force_n` if none fell)."""
-    from drake_biped.experiments.executor import episode_task
 
-    if not (math.isfinite(max_force_n) and max_force_n > 0 and math.isfinite(tolerance_n) and tolerance_n > 0):
-        raise ParameterError(f"max force {max_force_n!r} and tolerance {tolerance_n!r} must be > 0")
+def margin_of(forces: list[float], survived: list[list[bool]]) -> float:
+    """The largest force of `forces` (ascending) at and below which every phase survived; survived[i][j] is
+    force i at phase j. 0.0 when the smallest force falls at some phase."""
+    margin = 0.0
+    for force, row in zip(forces, survived):
+        if not all(row):
+            break
+        margin = force
+    return margin
+
+
+def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, int], None] | None = None
+                ) -> dict[str, Any]:
+    """The survival maps and margins of `settings` on `client`; the record (see the module's text)."""
+    from drake_biped.experiments.executor import episode_task, map_ordered
+
+    base, forces, phases = settings.config, settings.forces, settings.phases
     distance = base.sim.distance_m
-    chains = {}
-    for condition in CONDITIONS:
-        w = condition_window(condition, window)
+    unpushed = map_ordered(client, episode_task,
+                           [base.replace(window=condition_window(c, settings.window), push=None).to_dict()
+                            for c in CONDITIONS])
+    out: dict[str, Any] = {"window": list(settings.window), "max_force_n": settings.max_force_n,
+                           "force_step_n": settings.force_step_n, "forces_n": forces, "phases": phases,
+                           "settle_s": settings.settle_s, "push_duration_s": settings.push_duration_s,
+                           "distance_m": distance, "margins": {}}
+    jobs, keys = [], []
+    for condition, result in zip(CONDITIONS, unpushed):
+        step = steady_step(result, settings.settle_s) if survives(result, distance) else None
+        out["margins"][condition] = {"unpushed_walks": survives(result, distance),
+                                     "step_s": None if step is None else list(step)}
+        if step is None:
+            continue
+        window = condition_window(condition, settings.window)
         for direction, sign in (("forward", 1.0), ("backward", -1.0)):
-            chains[(condition, direction)] = {"window": w, "sign": sign, "lo": 0.0, "hi": None, "tried": []}
-
-    def config(chain, force):
-        return base.replace(window=chain["window"],
-                            push=Push(chain["sign"] * force, push_start_s, push_duration_s)).to_dict()
-
-    # First round: the largest force; then bisect where it fell.
-    rounds = 0
-    pending = {key: max_force_n for key in chains}
-    while pending:
-        keys = list(pending)
-        futures = [client.submit(episode_task, config(chains[k], pending[k]), pure=False) for k in keys]
-        for key, result in zip(keys, client.gather(futures)):
-            c, force = chains[key], pending[key]
-            ok = survives(result, distance)
-            c["tried"].append({"force_n": force, "survived": ok, "distance_m": result["distance_m"],
-                               "fall_reason": result["fall_reason"]})
-            if ok:
-                c["lo"] = max(c["lo"], force)
-            else:
-                c["hi"] = force if c["hi"] is None else min(c["hi"], force)
-        rounds += 1
-        if progress:
-            progress(rounds)
-        pending = {}
-        for key, c in chains.items():
-            if c["hi"] is not None and c["hi"] - c["lo"] > tolerance_n:
-                pending[key] = 0.5 * (c["lo"] + c["hi"])
-    out: dict[str, Any] = {"window": list(window), "max_force_n": max_force_n, "tolerance_n": tolerance_n,
-                           "push_start_s": push_start_s, "push_duration_s": push_duration_s, "margins": {}}
-    for (condition, direction), c in chains.items():
-        out["margins"].setdefault(condition, {})[direction] = {
-            "survived_n": c["lo"], "fell_n": c["hi"], "impulse_ns": c["lo"] * push_duration_s,
-            "tried": c["tried"]}
+            for i, force in enumerate(forces):
+                for j in range(phases):
+                    start = step[0] + (j / phases) * (step[1] - step[0])
+                    push = Push(sign * force, start, settings.push_duration_s)
+                    jobs.append(base.replace(window=window, push=push).to_dict())
+                    keys.append((condition, direction, i, j))
+    results = map_ordered(client, episode_task, jobs,
+                          (lambda n, r: progress(n, len(jobs))) if progress else None)
+    for m in out["margins"].values():
+        for direction in ("forward", "backward"):
+            m[direction] = {"margin_n": None, "survived": [[None] * phases for _ in forces],
+                            "distance_m": [[None] * phases for _ in forces]}
+    for (condition, direction, i, j), r in zip(keys, results):
+        cell = out["margins"][condition][direction]
+        cell["survived"][i][j] = survives(r, distance)
+        cell["distance_m"][i][j] = r["distance_m"]
+    for m in out["margins"].values():
+        for direction in ("forward", "backward"):
+            cell = m[direction]
+            if m["step_s"] is not None:
+                cell["margin_n"] = margin_of(forces, cell["survived"])
+                cell["impulse_ns"] = cell["margin_n"] * settings.push_duration_s
+                cell["phases_s"] = [m["step_s"][0] + (j / phases) * (m["step_s"][1] - m["step_s"][0])
+                                    for j in range(phases)]
     return out
 
 
-def markdown(record: dict[str, Any], tolerance_n: float, max_force_n: float) -> str:
-    """push_margin.md: the margins as a table."""
+def markdown(record: dict[str, Any]) -> str:
+    """push_margin.md: the margins and, per condition, where the grid's pushes fell."""
     window = record["window"]
-    lines = ["| | forward push survived (N) | backward push survived (N) |", "|---|---|---|"]
-    for condition, name in (("without", "without torque-free period"),
-                            ("with", f"with torque-free period {window[0]:.3f}-{window[1]:.3f} s")):
+    names = {"without": "without torque-free period",
+             "with": f"with torque-free period {window[0]:.4f}–{window[1]:.4f} s"}
+    lines = ["| | forward margin (N) | backward margin (N) | the step pushed (s) |", "|---|---|---|---|"]
+    for condition in CONDITIONS:
         m = record["margins"][condition]
-        lines.append(f"| {name} | {m['forward']['survived_n']:.1f} | {m['backward']['survived_n']:.1f} |")
-    return "\n".join(lines) + (f"\n\nPush for {record['push_duration_s']:g} s from {record['push_start_s']:g} s; "
-                               f"bisection to {tolerance_n:g} N, up to {max_force_n:g} N.\n")
+        if m["step_s"] is None:
+            lines.append(f"| {names[condition]} | — | — | the unpushed walk "
+                         f"{'has no step after the settling time' if m['unpushed_walks'] else 'falls'} |")
+            continue
+        lines.append(f"| {names[condition]} | {m['forward']['margin_n']:g} | {m['backward']['margin_n']:g} | "
+                     f"{m['step_s'][0]:.3f}–{m['step_s'][1]:.3f} |")
+    lines += ["", f"Each force from {record['force_step_n']:g} N to {record['max_force_n']:g} N in steps of "
+              f"{record['force_step_n']:g} N, for {record['push_duration_s']:g} s, at {record['phases']} phases of the "
+              f"first step after {record['settle_s']:g} s; survived: the walk still walks its "
+              f"{record['distance_m']:g} m. The margin: the largest force at and below which every phase survives.",
+              ""]
+    for condition in CONDITIONS:
+        m = record["margins"][condition]
+        if m["step_s"] is None:
+            continue
+        for direction in ("forward", "backward"):
+            falls = [f"{f:g} N at phase {j}/{record['phases']}" for f, row in zip(record["forces_n"],
+                                                                           m[direction]["survived"])
+                     for j, ok in enumerate(row) if not ok]
+            above = [x for x in falls if float(x.split(" N")[0]) > m[direction]["margin_n"]]
+            lines.append(f"- {names[condition]}, {direction}: {len(falls)} of "
+                         f"{len(record['forces_n']) * record['phases']} pushes fall"
+                         + (f"; the first above the margin: {above[0]}" if above else "") + ".")
+    return "\n".join(lines) + "\n"
+
+
+def figure(record: dict[str, Any], path: Path) -> None:
+    """The survival maps: force (signed: + forward) against the phase of the step, one panel per condition."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    forces, phases = record["forces_n"], record["phases"]
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 4.0), sharey=True)
+    for ax, condition in zip(axes, CONDITIONS):
+        m = record["margins"][condition]
+        ax.set_title(f"{condition} the window" + ("" if m["step_s"] else " (no steady step)"), fontsize=9)
+        if m["step_s"] is None:
+            continue
+        grid = np.full((2 * len(forces), phases), np.nan)
+        for j in range(phases):
+            for i in range(len(forces)):
+                grid[len(forces) - 1 - i, j] = float(m["backward"]["survived"][i][j])
+                grid[len(forces) + i, j] = float(m["forward"]["survived"][i][j])
+        signed = [-f for f in reversed(forces)] + list(forces)
+        step = record["force_step_n"]
+        ax.imshow(grid, origin="lower", aspect="auto", cmap="RdYlGn", vmin=0, vmax=1,
+                  extent=(-0.5 / phases, 1 - 0.5 / phases, signed[0] - step / 2, signed[-1] + step / 2))
+        for direction, sign in (("forward", 1), ("backward", -1)):
+            ax.axhline(sign * (m[direction]["margin_n"] + step / 2), color="k", lw=1, ls="--")
+        ax.set_xlabel("phase of the step pushed (fraction of its period)")
+    axes[0].set_ylabel("push force (N, + forward)")
+    fig.suptitle("Survival of a push in steady state (green survives; dashed: the margins)", fontsize=10)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
 
 
 def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
-    """The four bisections on `client` (a LocalCluster when None); writes push_margin.json and
-    push_margin.md into `out`. The record."""
-    import sys
-
+    """The survival maps on `client` (a LocalCluster when None); writes push_margin.json, push_margin.md and
+    push_margin.png into `out`. The record."""
     from drake_biped.experiments.executor import client_or_local
 
     out = Path(out)
     code = versions()
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=settings.episodes, desc="push margin", unit="episode")
     with client_or_local(client) as c:
-        record = push_margin(settings.config, settings.window, c, max_force_n=settings.max_force_n,
-                             tolerance_n=settings.tolerance_n, push_start_s=settings.push_start_s,
-                             push_duration_s=settings.push_duration_s,
-                             progress=(lambda n: print(f"round {n}", file=sys.stderr)) if progress else None)
+        record = push_margin(settings, c, progress=(lambda n, total: bar.update(1)) if bar else None)
+    if bar is not None:
+        bar.close()
     record.update(config=settings.config.to_dict(), versions=code)
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "push_margin.json", record)
-    write_text_atomic(out / "push_margin.md", markdown(record, settings.tolerance_n, settings.max_force_n))
+    write_text_atomic(out / "push_margin.md", markdown(record))
+    figure(record, out / "push_margin.png")
     return record

@@ -75,7 +75,7 @@ class Profile:
     window_step_s: float
     stability_trials: int
     jacobian: bool
-    margin_tolerance_n: float
+    margin_force_step_n: float  # the push-margin grid's spacing (N)
     slope: tuple[int, int]  # trials, episodes per slope
     slope_grid_full: bool  # the whole 2.0 deg grid (SLOPE_2DEG_*), or its 2 x 2 corner of lean and u_a
     time_steps: tuple[float, ...]
@@ -100,8 +100,8 @@ QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25
 # The full run: 79 min on 2 workers from scratch, its largest parts the learners' comparison (29 min), GARB's
 # two learning runs (31 min) and the Table IV grid (10 min) (docs/RESULTS.md, its steps counted one by one; the
 # same steps took 2.0-2.5 x as long on another 2-core machine).
-FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 1.0, (2, 100), True,
-               (0.00025, 0.0005, 0.001, 0.002, 0.005), 10.0, 80.0, compare=(5, 300))
+FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 5.0, (2, 100), True,
+               (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 80.0, compare=(5, 300))
 
 
 class Reproduction:
@@ -275,7 +275,8 @@ class Reproduction:
         settings = {"steps": list(p.time_steps), "distance_m": p.time_step_distance_m}
 
         def run(folder: Path) -> dict:
-            rec = time_step.run(time_step.TimeStepSettings(tuple(p.time_steps), 0.0005, p.time_step_distance_m),
+            rec = time_step.run(time_step.TimeStepSettings(tuple(p.time_steps), min(p.time_steps),
+                                                           p.time_step_distance_m),
                                 folder, self._client, progress=False)
             return {"chosen_step_s": rec["chosen_step_s"], "passing_steps": rec["passing_steps"]}
 
@@ -355,16 +356,17 @@ class Reproduction:
     def push_margin(self) -> dict:
         from drake_biped.experiments import push_margin
 
-        tol = self.profile.margin_tolerance_n
+        step = self.profile.margin_force_step_n
         window, source, _ = self.learned_window()
+        config = self.level.override({"sim.distance_m": 12.0, "sim.max_time_s": 72.0})
 
         def run(folder: Path) -> dict:
-            record = push_margin.run(push_margin.PushMarginSettings(self.level, window, 200.0, tol), folder,
+            record = push_margin.run(push_margin.PushMarginSettings(config, window, 100.0, step), folder,
                                      self._client, progress=False)
             return {"margins": _margins(record), "window_source": source}
 
-        return self.experiment("push_margin", {"tolerance_n": tol, "window": list(window),
-                                               "distance_m": self.profile.distance_m}, run)
+        return self.experiment("push_margin", {"force_step_n": step, "window": list(window),
+                                               "distance_m": 12.0}, run)
 
     def floquet(self) -> dict:
         from drake_biped.experiments import floquet
@@ -507,7 +509,8 @@ def _cells(record: dict) -> dict:
 
 def _margins(record: dict) -> dict:
     """A push-margin record's survived forces, without and with the window, forward and backward."""
-    return {c: {d: record["margins"][c][d]["survived_n"] for d in ("forward", "backward")} for c in ("without", "with")}
+    return {c: {d: record["margins"][c].get(d, {}).get("margin_n") for d in ("forward", "backward")}
+            for c in ("without", "with")}
 
 
 @dataclass(frozen=True)
