@@ -109,6 +109,9 @@ def richardson(rows: list[dict], steps: list[float], window) -> dict:
         if 0.5 <= observed <= 3.0:
             p, out["order_observed"] = observed, True
     limit = c4 + (c4 - c2) / (2.0 ** p - 1.0)
+    hw = [by[h].get("half_width") or 0.0 for h in fine]
+    # the differences the estimate rests on, against their own 95 % intervals: below them it extrapolates noise
+    out["noise_dominated"] = bool(abs(d_fine) <= math.hypot(hw[0], hw[1]) or abs(d_coarse) <= math.hypot(hw[1], hw[2]))
     out.update(order=p, limit=limit,
                errors={f"{h:g}": (by[h]["cost_of_transport"] / limit - 1.0
                                   if by[h]["walked"] and by[h]["cost_of_transport"] else None) for h in steps})
@@ -126,8 +129,11 @@ def choose_step(rows: list[dict], steps: list[float], reference: float, toleranc
     rows: one per (time_step_s, window) with "walked" and "cost_of_transport"; each gains "cmt_deviation"
     (relative to the same walk at the reference step, None when either fell). A walk that falls at the
     reference has no reference C_mt: it is listed in "not_judged". A step passes when every judged walk
-    walks there with |deviation| <= tolerance. The chosen step is the largest one at or above the
-    reference (the finest step, by default) such that it and every step between it and the reference pass.
+    walks there with |deviation| <= tolerance, or within the 95 % interval of the difference (rows that carry
+    their long-run "half_width": an irregular gait's 100 m mean scatters by about 2 %, and a step whose walk is
+    indistinguishable from the reference's at that length is not failed by the scatter). The chosen step is
+    the largest one at or above the reference (the finest step, by default) such that it and every step
+    between it and the reference pass.
     """
     ref = {tuple(r["window"] or ()): r for r in rows if r["time_step_s"] == reference}
     for r in rows:
@@ -135,10 +141,17 @@ def choose_step(rows: list[dict], steps: list[float], reference: float, toleranc
         ok = (r["walked"] and base is not None and base["walked"] and r["cost_of_transport"] is not None
               and base["cost_of_transport"] is not None)
         r["cmt_deviation"] = (r["cost_of_transport"] / base["cost_of_transport"] - 1.0) if ok else None
+        # the 95 % interval of the difference, where the rows carry their long-run intervals
+        r["deviation_noise"] = (math.hypot(r.get("half_width") or 0.0, base.get("half_width") or 0.0)
+                                / base["cost_of_transport"]) if ok else None
     judged = {key for key, r in ref.items() if r["walked"]}
+
+    def agrees(r) -> bool:
+        dev = r["cmt_deviation"]
+        return dev is not None and (abs(dev) <= tolerance or abs(dev) <= r["deviation_noise"])
+
     passing = [h for h in steps
-               if all(r["cmt_deviation"] is not None and abs(r["cmt_deviation"]) <= tolerance
-                      for r in rows if r["time_step_s"] == h and tuple(r["window"] or ()) in judged)]
+               if all(agrees(r) for r in rows if r["time_step_s"] == h and tuple(r["window"] or ()) in judged)]
     chosen = None
     for h in sorted(x for x in steps if x >= reference):
         if h not in passing:
@@ -167,7 +180,9 @@ def markdown(rec: dict) -> str:
         if r["cost_of_transport"] is None:
             return "too short"
         dev = r["cmt_deviation"]
-        mark = "" if dev is None or abs(dev) <= rec["tolerance"] else " ✗"
+        noise = r.get("deviation_noise") or 0.0
+        mark = ("" if dev is None or abs(dev) <= rec["tolerance"]
+                else " ≈" if abs(dev) <= noise else " ✗")
         text = f"{r['cost_of_transport']:.4f} ± {r['half_width']:.4f}"
         return f"{text} ({signed_percent(dev)}){mark}" if dev is not None else text
 
@@ -182,7 +197,8 @@ def markdown(rec: dict) -> str:
             continue
         order = f"{e['order']:.2f}" + ("" if e["order_observed"] else " (assumed)")
         errs = [signed_percent(e["errors"].get(f"{h:g}"), 2) for h in steps]
-        rich_lines.append(f"| {label(w)} | {e['limit']:.4f} | {order} | " + " | ".join(errs) + " |")
+        limit = f"{e['limit']:.4f}" + (" (noise-dominated)" if e.get("noise_dominated") else "")
+        rich_lines.append(f"| {label(w)} | {limit} | {order} | " + " | ".join(errs) + " |")
     control = sorted({(r["time_step_s"], r.get("control_period_s")) for r in rec["rows"]})
     lines = [
         "# Time-step study: the long-run cost of transport as the plant step is halved",
@@ -195,7 +211,8 @@ def markdown(rec: dict) -> str:
         f"Drake {rec['versions']['drake']}, {rec['date']}.",
         "",
         f"**Chosen step: {chosen * 1e3:g} ms**, the coarsest with the long-run C_mt of every walk that walks at "
-        f"the reference within {100 * rec['tolerance']:g} % of it (and every finer step too)." if chosen else
+        f"the reference within {100 * rec['tolerance']:g} % of it, or within the 95 % interval of the difference "
+        "(≈: indistinguishable at this length), and every finer step too." if chosen else
         "**No step passes** the tolerance for every walk.",
         "",
         *([f"Not judged (they fall at the reference step): {', '.join(label(w) for w in rec['not_judged'])}.", ""]
@@ -205,6 +222,9 @@ def markdown(rec: dict) -> str:
         *table(cmt),
         "",
         "## Richardson's estimate from the three finest steps",
+        "",
+        "Noise-dominated: a difference between two of the three finest steps lies within its 95 % interval, so "
+        "the estimate extrapolates the walks' scatter, not the discretisation.",
         "",
         *rich_lines,
         "",
