@@ -75,3 +75,15 @@ def long_run_cost(times_s, com_x_m, positive_work_j, mass_kg: float, g: float,
     out.update(cost_of_transport=cost, interval_95=[cost - half, cost + half], half_width=half,
                batch_costs=batch_costs.tolist())
     return out
+
+
+def long_run_of_record(result: dict, g: float, transient_m: float = TRANSIENT_M, batches: int = BATCHES) -> dict:
+    """long_run_cost of an episode's record (a result.json's dict: its "steps" and "mass_kg"); a step recorded
+    without its work (a record from before touchdowns counted it) gives no long-run cost."""
+    steps = result["steps"]
+    work = [math.nan if s.get("positive_work_j") is None else s["positive_work_j"] for s in steps]
+    out = long_run_cost([s["touchdown_time_s"] for s in steps], [s["com_x_m"] for s in steps], work,
+                        result["mass_kg"], g, transient_m, batches)
+    if out["cost_of_transport"] is not None and not math.isfinite(out["cost_of_transport"]):
+        out.update(cost_of_transport=None, interval_95=None, half_width=None, batch_costs=[])
+    return out

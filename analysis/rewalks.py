@@ -1,8 +1,10 @@
 """Learned torque-free periods re-walked where the learner did not walk them (the record's summary and report;
 the walks: `drake_biped.experiments.rewalk`).
 
-A walk's saving is 1 - C_mt(window) / C_mt(no window) under the same change; where either walk falls it has
-none (a fall is counted, never averaged). A trial's saving is the mean of its four walks' (as learned and the
+A walk's saving is 1 - C_mt(window) / C_mt(no window) under the same change, each the walk's long-run C_mt
+(analysis.long_run: the walks are 110 m, the first 10 m dropped) where the record has it, else the episode's
+(records made before walks were long); where either walk falls it has none (a fall is counted, never
+averaged). A trial's saving is the mean of its four walks' (as learned and the
 three changes); the run's figure is the mean over trials with its standard deviation. A trial holds when every
 one of its four walks walks and saves at least HOLD_SAVING.
 """
@@ -15,7 +17,7 @@ import numpy as np
 
 from drake_biped.analysis.series import signed_percent
 
-__all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "summary"]
+__all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary"]
 
 # The walk as learned, then the changes it is re-walked under.
 CHANGES = ("as_learned", "half_step", "speed_0.95", "speed_1.05")
@@ -27,10 +29,18 @@ HOLD_SAVING = 0.35
 KEEP = ("cost_of_transport", "distance_m", "fell", "mean_speed_mps", "step_period_s")
 
 
+def measured_cost(row: dict[str, Any]) -> float | None:
+    """A re-walk's C_mt: its long-run one where it was measured, else the episode's."""
+    if "long_run_cost_of_transport" in row:
+        return row["long_run_cost_of_transport"]
+    return row["cost_of_transport"]
+
+
 def _saving(row: dict[str, Any], base: dict[str, Any]) -> float | None:
-    if row["fell"] or base["fell"] or not row["cost_of_transport"] or not base["cost_of_transport"]:
+    cost, base_cost = measured_cost(row), measured_cost(base)
+    if row["fell"] or base["fell"] or not cost or not base_cost:
         return None
-    return 1.0 - row["cost_of_transport"] / base["cost_of_transport"]
+    return 1.0 - cost / base_cost
 
 
 def summary(time_step_s: float, speed_mps: float, learned: list[dict[str, Any]],
@@ -72,11 +82,13 @@ def markdown(record: dict[str, Any]) -> str:
     words = [CHANGE_WORDS[c] for c in record["changes"]]
     lines = [f"Each learned window re-walked: {', '.join(words)}; each against the walk without a window "
              f"under the same change (plant step {1e3 * record['time_step_s']:g} ms, initiation "
-             f"{record['speed_mps']:g} m/s). A trial holds when it saves ≥ {100 * record['hold_saving']:.0f} % "
-             "in every walk.", "",
+             f"{record['speed_mps']:g} m/s"
+             + (f"; {record['distance_m']:g} m walks, C_mt the long-run mean after the first 10 m" if
+                record.get("distance_m") else "")
+             + f"). A trial holds when it saves ≥ {100 * record['hold_saving']:.0f} % in every walk.", "",
              "| trial | window (s) | " + " | ".join(words) + " | mean | holds |",
              "|---|---|" + "---:|" * len(words) + "---:|---|"]
-    base = " | ".join(f"C_mt {r['cost_of_transport']:.4f}" if not r["fell"] else "falls"
+    base = " | ".join(f"C_mt {measured_cost(r):.4f}" if not r["fell"] and measured_cost(r) else "falls"
                       for r in record["no_window"].values())
     lines.append(f"| no window | — | {base} | | |")
     for t in record["trials"]:

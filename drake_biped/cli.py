@@ -197,7 +197,7 @@ def cmd_window_map(args: argparse.Namespace) -> int:
     from drake_biped.experiments import window_map
 
     settings = window_map.WindowMapSettings(_episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
-                                            t1_step_s=args.step, t2_step_s=args.step)
+                                            t1_step_s=args.step, t2_step_s=args.step, force=args.force)
     with _client(args) as client:
         record = window_map.run(settings, Path(args.out), client)
     _print(window_map.summary_lines(record))
@@ -270,7 +270,8 @@ def cmd_learn(args: argparse.Namespace) -> int:
     learning.check_resume(record_settings, out)
     check_run_log(out, "learn")  # before a cluster starts
     with _client(args) as client:
-        record = learning.run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler)
+        record = learning.run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler,
+                              rewalk_distance_m=args.rewalk_distance)
     _print(learning.summary_lines(record, out))
     return 0
 
@@ -351,8 +352,13 @@ def cmd_floquet(args: argparse.Namespace) -> int:
     out = Path(args.out)
     with _client(args) as client:
         record = floquet.run(settings, out, client)
+    from drake_biped.analysis.floquet import record_verdict
+
+    epsilon = record["converged_epsilon"]
     print(f"spectral radius {record['spectral_radius']:.4f}, fixed-point residual "
-          f"{record['fixed_point_residual']:.1e}, converged epsilon {record['converged_epsilon']}")
+          f"{record['fixed_point_residual']:.1e}, "
+          + ("no perturbation converged" if epsilon is None else f"converged at epsilon {epsilon:g}")
+          + f": {record_verdict(record)}")
     print(f"wrote {out}/floquet.json, floquet.md, floquet.png")
     return 0
 
@@ -694,6 +700,10 @@ def build_parser() -> argparse.ArgumentParser:
                        metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
     learn.add_argument("--variance", type=number("positive"), default=0.04,
                        help="the policy's variance per time (s^2); default 0.04 as in the paper")
+    learn.add_argument("--rewalk-distance", type=number("positive"), default=None,
+                       help="how far each final policy mean (and no window) is re-walked, as learned, at half the "
+                            "step and from 0.95 / 1.05 x the initiation speed (m); from 110 m on, each walk's C_mt is "
+                            "its long-run mean after the first 10 m (default: 110, or --distance when under 10 m)")
     _add_resumable_run_options(learn)
     learn.set_defaults(func=cmd_learn)
 
@@ -800,7 +810,49 @@ def build_parser() -> argparse.ArgumentParser:
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")
     figs.set_defaults(func=cmd_figures)
+    for command in sub.choices.values():  # every command that writes a folder can be told to replace it
+        if any(a.dest == "out" for a in command._actions):
+            command.add_argument("--overwrite", action="store_true",
+                                 help="replace the records of another run (another command or other settings) "
+                                      "in --out; without it such a folder is refused")
     return parser
+
+
+# Counts a resumable command's run is extended by when given larger (never shortened).
+_GROWABLE = {"learn": ("episodes", "trials"), "compare-learners": ("episodes", "trials"),
+             "gait-search": ("generations",), "slope": ("episodes", "trials"), "stability": ("trials",)}
+
+# What does not change a run's records: where it runs and how it reports. Every other option is part of the
+# settings an output folder is held for (records.claim_folder).
+_NOT_SETTINGS = {"out", "workers", "scheduler", "force", "debug", "overwrite", "func", "command", "replot"}
+
+
+def _settings_of(args: argparse.Namespace) -> dict:
+    """The options of a command that decide its records, as JSON values."""
+    def plain(value):
+        if isinstance(value, Path):
+            return str(value)
+        if isinstance(value, (list, tuple)):
+            return [plain(v) for v in value]
+        if isinstance(value, (str, int, float, bool)) or value is None:
+            return value
+        return str(value)
+
+    return {k: plain(v) for k, v in sorted(vars(args).items()) if k not in _NOT_SETTINGS}
+
+
+@contextmanager
+def _holding_the_out_folder(args: argparse.Namespace) -> Iterator[None]:
+    """records.claim_folder on --out for a command that writes one (not a --replot, which redraws its own)."""
+    out = getattr(args, "out", None)
+    if out is None or getattr(args, "replot", False):
+        yield
+        return
+    from drake_biped.records import claim_folder
+
+    with claim_folder(Path(out), args.command, _settings_of(args), overwrite=getattr(args, "overwrite", False),
+                      growable=_GROWABLE.get(args.command, ())):
+        yield
 
 
 DEBUG_ENV = "DRAKE_BIPED_DEBUG"
@@ -821,7 +873,7 @@ def main(argv: list[str] | None = None) -> int:
     out = getattr(args, "out", None)
     again = ("run the same command again to resume: finished work is kept in " + str(out)
              if args.command in RESUMABLE and out else "run the same command again")
-    with _failures_as_one_line(f"drake-biped {args.command}", debug, again):
+    with _failures_as_one_line(f"drake-biped {args.command}", debug, again), _holding_the_out_folder(args):
         return args.func(args)
     return 0  # not reached: a failure leaves by SystemExit
 

@@ -22,7 +22,7 @@ from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
 from drake_biped.model import JOINT_NAMES, joint_index
-from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, SimulationParams
+from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, SimulationParams
 from drake_biped.records import atomic_file, write_text_atomic
 from drake_biped.versions import versions
 
@@ -365,7 +365,15 @@ def run_episode(
     The episode ends at the control update that detects a fall or the distance walked; its duration,
     distance and work are those of the plant state that update read (see controller "Timing").
     """
-    config = config or EpisodeConfig()
+    config = EpisodeConfig() if config is None else config
+    if not isinstance(config, EpisodeConfig):
+        raise ParameterError(f"run_episode: config must be an EpisodeConfig (or None for the default), got "
+                             f"{type(config).__name__}")
+    if cache is not None and not isinstance(cache, DiagramCache):
+        raise ParameterError(f"run_episode: cache must be a DiagramCache or None, got {type(cache).__name__} "
+                             f"{cache!r}")
+    if kick is not None and not isinstance(kick, Kick):
+        raise ParameterError(f"run_episode: kick must be a Kick or None, got {type(kick).__name__}")
     parts, simulator, reason, wall = simulate(
         config, meshcat=meshcat, progress=progress, record=record_trajectory, cache=cache, kick=kick
     )

@@ -45,7 +45,7 @@ from drake_biped.kinematics import (
     leg_points_k,
     link_masses,
 )
-from drake_biped.params import GRAVITY_MPS2, ContactParams, Ground, RobotModel
+from drake_biped.params import GRAVITY_MPS2, ContactParams, Ground, ParameterError, RobotModel
 from drake_biped.resources import model_package_xml
 
 MODEL_URL = "package://drake_biped/biped.urdf"
@@ -242,6 +242,18 @@ def _add_ground(plant: MultibodyPlant, ground: Ground, contact: ContactParams) -
         add_visual("ground_slope_visual", ground.slope_rad, ground.level_length_m, visual_end, 0.0)
 
 
+def actuator_of(plant: MultibodyPlant, joint: str):
+    """The actuator driving `joint`: whatever the model names it (a URDF's <transmission> names its actuator,
+    `left_hip_motor` in the shipped model; Drake names an SDFormat actuator after its joint). ModelError naming
+    the joint when none drives it."""
+    for index in plant.GetJointActuatorIndices():
+        actuator = plant.get_joint_actuator(index)
+        if actuator.joint().name() == joint:
+            return actuator
+    raise ModelError(f"the model has no actuator for joint {joint} (a URDF <transmission> for it, or an SDFormat "
+                     "<drake:controller>/effort limit on the joint)")
+
+
 def check_layout(plant: MultibodyPlant) -> None:
     """Raise ModelError unless the joints and actuators are named as the shipped model's and positions,
     velocities and actuators follow JOINT_NAMES' order."""
@@ -249,8 +261,7 @@ def check_layout(plant: MultibodyPlant) -> None:
         if not plant.HasJointNamed(name):
             raise ModelError(f"the model has no joint named {name!r}; expected {['floating_base', *JOINT_NAMES]}")
     for name in JOINT_NAMES:
-        if not plant.HasJointActuatorNamed(f"{name}_motor"):
-            raise ModelError(f"the model has no actuator named {name + '_motor'!r} (a <transmission> for joint {name})")
+        actuator_of(plant, name)
     if plant.num_positions() != 9 or plant.num_velocities() != 9 or plant.num_actuators() != 6:
         raise ModelError(
             f"expected 9 positions, 9 velocities and 6 actuators, got {plant.num_positions()}, "
@@ -263,9 +274,9 @@ def check_layout(plant: MultibodyPlant) -> None:
         joint = plant.GetJointByName(name)
         if joint.position_start() != 3 + i or joint.velocity_start() != 3 + i:
             raise ModelError(f"joint {name} is at position {joint.position_start()}, expected {3 + i}")
-        actuator = plant.GetJointActuatorByName(f"{name}_motor")
+        actuator = actuator_of(plant, name)
         if int(actuator.index()) != i:
-            raise ModelError(f"actuator {name}_motor has index {int(actuator.index())}, expected {i}")
+            raise ModelError(f"actuator {actuator.name()} has index {int(actuator.index())}, expected {i}")
 
 
 def _check_masses(model: RobotModel) -> None:
@@ -278,6 +289,7 @@ def _check_masses(model: RobotModel) -> None:
     except ET.ParseError as exc:
         raise ModelError(f"could not parse the model {model.name}: {exc}") from None
     for link in root.iter("link"):
+        _check_inertia(model, link)
         mass = link.find("inertial/mass")
         if mass is None:
             continue
@@ -290,6 +302,44 @@ def _check_masses(model: RobotModel) -> None:
         if not value > 0.0:
             raise ModelError(f"the model {model.name}: link {link.get('name')} has mass {value!r} kg; every "
                              "link's mass must be positive")
+
+
+def _check_inertia(model: RobotModel, link) -> None:
+    """ModelError naming the link when its rotational inertia is not physical: a negative moment, or one
+    larger than the other two together (Drake's parser only warns, and walks it)."""
+    inertia = link.find("inertial/inertia")
+    if inertia is None:
+        return
+    names = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    try:
+        if model.format == "urdf":
+            values = {n: float(inertia.get(n, "0")) for n in names}
+        else:
+            values = {n: float(getattr(inertia.find(n), "text", None) or 0.0) for n in names}
+    except ValueError:
+        raise ModelError(f"the model {model.name}: link {link.get('name')}'s inertia is not a set of numbers") \
+            from None
+    matrix = np.array([[values["ixx"], values["ixy"], values["ixz"]], [values["ixy"], values["iyy"], values["iyz"]],
+                       [values["ixz"], values["iyz"], values["izz"]]])
+    moments = np.linalg.eigvalsh(matrix)
+    tolerance = 1e-12 * max(1.0, float(np.max(np.abs(moments))))
+    if not np.all(np.isfinite(matrix)) or moments[0] < -tolerance or \
+            2.0 * float(np.max(moments)) > float(np.sum(moments)) + tolerance:
+        shown = ", ".join(f"{n} {values[n]:g}" for n in names)
+        raise ModelError(f"the model {model.name}: link {link.get('name')} has the inertia ({shown}) kg*m^2, which no "
+                         "body has (principal moments must be >= 0 and each at most the sum of the other two)")
+
+
+def _check_joint_limits(plant: MultibodyPlant) -> None:
+    """ModelError naming the joint unless each leg joint has finite position limits: the gait relies on the
+    knee's stop at full extension and on the hips' and ankles' ranges."""
+    for name in JOINT_NAMES:
+        joint = plant.GetJointByName(name)
+        lower, upper = float(joint.position_lower_limits()[0]), float(joint.position_upper_limits()[0])
+        if not (math.isfinite(lower) and math.isfinite(upper)):
+            raise ModelError(f"joint {name} has the position limits [{lower:g}, {upper:g}] rad; the toolkit's "
+                             "controller relies on finite limits for every leg joint (the knee's stop at full "
+                             "extension, the hips' and ankles' ranges): give it <limit lower=... upper=...>")
 
 
 LINKS = ("torso", *(f"{leg}_{link}" for leg in LEGS for link in ("thigh", "shank", "foot")))
@@ -377,6 +427,7 @@ def body_of(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: float =
         raise ModelError(f"the model's gravity is {gravity.tolist()} m/s^2; the toolkit uses "
                          f"[0, 0, -{GRAVITY_MPS2}] (C_mt divides by m g d with it)")
     masses = link_masses_of(plant)
+    _check_joint_limits(plant)
     legs = {leg: _leg_geometry(plant, scene_graph, leg) for leg in LEGS}
     for key, what in _GEOMETRY_NAMES.items():
         left, right = legs["left"][key], legs["right"][key]
@@ -416,7 +467,7 @@ def _check_body(plant: MultibodyPlant, body: np.ndarray, tolerance_m: float) -> 
 
 def effort_limits(plant: MultibodyPlant) -> np.ndarray:
     """Actuator torque limits (N*m) in JOINT_NAMES order, as read from the model file."""
-    return np.array([plant.GetJointActuatorByName(f"{n}_motor").effort_limit() for n in JOINT_NAMES])
+    return np.array([actuator_of(plant, n).effort_limit() for n in JOINT_NAMES])
 
 
 def motor_limits(plant: MultibodyPlant) -> tuple[float, float, float]:
@@ -451,6 +502,9 @@ _BODIES: dict[str | None, np.ndarray] = {}
 def body_of_model(model: RobotModel | None = None) -> np.ndarray:
     """The body (kinematics.BODY) of `model` (None: the shipped robot), read from its plant once per model
     and kept; ModelError as `add_biped`. A read-only array."""
+    if model is not None and not isinstance(model, RobotModel):
+        raise ParameterError(f"body_of_model: model must be a RobotModel (RobotModel.from_file(path)) or None for "
+                             f"the shipped robot, got {type(model).__name__} {model!r}")
     key = None if model is None else model.sha256
     if key not in _BODIES:
         handles = add_biped(DiagramBuilder(), Ground(), 1e-3, model)

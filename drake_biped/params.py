@@ -24,7 +24,7 @@ from drake_biped.paper import (
 __all__ = [
     "ContactParams", "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
-    "with_time_step", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "with_time_step", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "RobotModel",
 ]
 
@@ -577,13 +577,24 @@ class EpisodeConfig(_Validated):
             raise ParameterError(f"EpisodeConfig.override: values must be a mapping of field names to values "
                                  f"({{'u_a': 1.8}}), got {type(values).__name__} {shown}")
         sections: dict[str, dict[str, Any]] = {}
+        seed = self.seed
         for name, value in values.items():
+            if name == "seed":  # the one field outside the sections
+                seed = value
+                continue
             section, attr = resolve_field(name)
             if section not in sections:
                 current = getattr(self, section)
                 sections[section] = (current or _SECTIONS[section]()).to_dict()
             sections[section][attr] = value
-        return self.replace(**{k: _SECTIONS[k].from_dict(v) for k, v in sections.items()})
+        return self.replace(seed=seed, **{k: _SECTIONS[k].from_dict(v) for k, v in sections.items()})
+
+
+def check_settings(settings: Any, cls: type, where: str) -> None:
+    """ParameterError naming `where` unless `settings` is a `cls` (an experiment's run takes its settings
+    dataclass, never a mapping or a path)."""
+    if not isinstance(settings, cls):
+        raise ParameterError(f"{where}: settings must be a {cls.__name__}, got {type(settings).__name__}")
 
 
 def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:

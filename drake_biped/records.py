@@ -12,7 +12,7 @@ from typing import Any
 
 from drake_biped.params import ParameterError
 
-__all__ = ["atomic_file", "read_json", "read_kept", "save_figure", "set_aside", "warn", "write_atomic",
+__all__ = ["LOCK_FILE", "RUN_FILE", "atomic_file", "claim_folder", "read_json", "read_kept", "save_figure", "set_aside", "warn", "write_atomic",
            "write_text_atomic"]
 
 
@@ -103,3 +103,112 @@ def save_figure(fig, path: Path, **kwargs) -> None:
     """`fig.savefig(path, **kwargs)`, atomically."""
     with atomic_file(path) as tmp:
         fig.savefig(tmp, **kwargs)
+
+
+# The run that wrote an output folder (its command and settings), and the lock of the process writing it now.
+RUN_FILE = "drake-biped-run.json"
+LOCK_FILE = ".drake-biped.lock"
+
+
+@contextmanager
+def claim_folder(out: Path, command: str, settings: dict[str, Any], overwrite: bool = False,
+                 option: str = "--out", growable: tuple[str, ...] = ()) -> Iterator[None]:
+    """Hold the output folder `out` for one run of `command` with `settings` (a JSON-able mapping) while the
+    block runs.
+
+    One process at a time: a second run into a folder held by another is refused, naming the holder. A folder
+    holding another run's records (RUN_FILE names another command or other settings) is refused, naming both,
+    unless `overwrite`, which empties it first; the same command with the same settings continues (a resume),
+    and so does one whose `growable` settings (counts: episodes, trials, generations) are larger: a run is
+    extended, never shortened. A folder of records written without RUN_FILE is taken over as it is.
+    ParameterError naming `option`."""
+    import fcntl
+    import shutil
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    lock_path = out / LOCK_FILE
+    lock = open(lock_path, "a+")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        lock.seek(0)
+        holder = lock.read().strip() or "another process"
+        lock.close()
+        raise ParameterError(f"{option} {out}: another run is writing this folder ({holder}); wait for it to end, "
+                             "or choose another folder") from None
+    fresh = False
+    try:
+        lock.seek(0)
+        lock.truncate()
+        lock.write(f"process {os.getpid()}: drake-biped {command}\n")
+        lock.flush()
+        header = out / RUN_FILE
+        this = {"command": command, "settings": settings}
+        if header.is_file():
+            try:
+                before = json.loads(header.read_text())
+            except (OSError, ValueError):
+                before = None
+            shorter = _shortened(before, this, growable)
+            if shorter and not overwrite:
+                raise ParameterError(f"{option} {out} holds a longer run of the same command ({shorter}): a run is "
+                                     "extended, never shortened; give the larger count, choose another folder, "
+                                     "or give --overwrite to replace its records")
+            if not _same_run(before, this, growable):
+                if not overwrite:
+                    raise ParameterError(f"{option} {out} holds the records of another run ({_difference(before, this)}"
+                                         "): rerun that command to resume it, choose another folder, or give "
+                                         "--overwrite to replace its records")
+                for entry in out.iterdir():
+                    if entry.name != LOCK_FILE:
+                        shutil.rmtree(entry) if entry.is_dir() and not entry.is_symlink() else entry.unlink()
+                fresh = True
+        else:
+            fresh = not any(p.name not in (LOCK_FILE, ".drake-biped-write-test") for p in out.iterdir())
+        created = not header.is_file() or fresh
+        write_text_atomic(header, json.dumps(this, indent=1, sort_keys=True) + "\n")
+        try:
+            yield
+        except BaseException:
+            if created:  # a run refused or failed in a folder it began: the folder keeps no claim of it
+                header.unlink(missing_ok=True)
+            raise
+    finally:
+        lock_path.unlink(missing_ok=True)
+        fcntl.flock(lock, fcntl.LOCK_UN)
+        lock.close()
+
+
+def _same_run(before: Any, this: dict[str, Any], growable: tuple[str, ...]) -> bool:
+    """Whether `this` run continues `before`: the same command and settings, `growable` counts aside."""
+    if not isinstance(before, dict) or not isinstance(before.get("settings"), dict):
+        return False
+    drop = set(growable)
+    return before.get("command") == this["command"] and \
+        {k: v for k, v in before["settings"].items() if k not in drop} == \
+        {k: v for k, v in this["settings"].items() if k not in drop}
+
+
+def _shortened(before: Any, this: dict[str, Any], growable: tuple[str, ...]) -> str:
+    """The growable counts `this` run asks fewer of than `before` ran, in the command line's words ("" when
+    none, or when the runs differ otherwise)."""
+    if not _same_run(before, this, growable):
+        return ""
+    old, new = before["settings"], this["settings"]
+    fewer = [f"--{k} {new[k]} here, {old[k]} there" for k in growable
+             if isinstance(old.get(k), int) and isinstance(new.get(k), int) and new[k] < old[k]]
+    return "; ".join(fewer)
+
+
+def _difference(before: Any, this: dict[str, Any]) -> str:
+    """What differs between a folder's run and this one, in the command line's words."""
+    if not isinstance(before, dict) or not isinstance(before.get("settings"), dict):
+        return "an unreadable run record"
+    if before.get("command") != this["command"]:
+        return f"drake-biped {before.get('command')}; this run is drake-biped {this['command']}"
+    old, new = before["settings"], this["settings"]
+    changed = [f"--{k.replace('_', '-')} {old.get(k)!r} there, {new.get(k)!r} here"
+               for k in sorted(set(old) | set(new)) if old.get(k) != new.get(k)]
+    text = f"drake-biped {this['command']} with other settings: " + "; ".join(changed)
+    return text if len(text) <= 240 else text[:237] + "..."

@@ -158,8 +158,8 @@ def test_a_failed_run_is_one_line_with_exit_code_1_and_a_traceback_on_request(tm
 
 
 def _learn(tmp_path, episodes=2):
-    return ["learn", "--trials", "1", "--episodes", str(episodes), "--distance", "0.5", "--workers", "1",
-            "--out", str(tmp_path / "l")]
+    return ["learn", "--trials", "1", "--episodes", str(episodes), "--distance", "0.5", "--rewalk-distance", "0.5",
+            "--workers", "1", "--out", str(tmp_path / "l")]
 
 
 @pytest.mark.slow
@@ -544,8 +544,10 @@ def test_a_run_log_belongs_to_one_command_and_another_command_is_refused_before_
     code, lines = run_cli(capsys, ["grid", "--spec", "tiny", "--distance", "0.5", "--workers", "1",
                                    "--out", str(tmp_path / "l")])
     assert code == 2
-    one_line(lines, f"{log} is the run log of drake-biped learn", "grid does not run into", "a folder of its own")
+    one_line(lines, f"--out {tmp_path / 'l'} holds the records of another run (drake-biped learn",
+             "this run is drake-biped grid", "--overwrite")
     assert log.read_text() == before and sorted(p.name for p in (tmp_path / "l").iterdir()) == files
+    # a folder whose records name no run (written through the API): the learning run's own log refuses it
     # and the other way round, through the API too: a grid's log is never a learning run's
     from drake_biped.experiments.progress import RunProgress, SessionLog
 

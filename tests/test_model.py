@@ -224,6 +224,10 @@ def test_a_changed_body_is_read_from_the_plant_and_its_kinematics_agrees_with_it
     ('<joint name="left_knee" type="revolute">', '<joint name="left_knee_joint" type="revolute">',
      r"biped.urdf:\d+: .*joint 'left_knee'"),
     ('<link name="left_shank">', '<link name="left_lower_leg">', "the model has no link named 'left_shank'"),
+    ('<limit lower="0.0" upper="2.4" effort="30" velocity="100"/>', '<limit effort="30" velocity="100"/>',
+     r"joint left_knee has the position limits \[-inf, inf\] rad; the toolkit's controller relies on finite"),
+    ('ixx="0.0680905"', 'ixx="-0.0680905"', r"link torso has the inertia \(ixx -0.0680905, .*which no body has"),
+    ('izz="0.0177227"', 'izz="0.2"', r"link torso has the inertia \(.*izz 0.2, ixy 0, ixz 0, iyz 0\) kg\*m\^2"),
 ])
 def test_a_model_the_toolkit_cannot_read_is_refused_by_name(tmp_path, old, new, match):
     from pydrake.systems.framework import DiagramBuilder
@@ -407,7 +411,7 @@ def test_the_motors_limits_are_the_models_and_the_work_is_of_the_applied_torque(
 
 @pytest.mark.parametrize("value, match", [
     (None, r"the motor left_hip_motor has the effort limit inf N\*m; the controller needs a finite positive"),
-    ("0", r"the model has no actuator named 'left_hip_motor'"),  # Drake drops a zero-effort transmission
+    ("0", r"the model has no actuator for joint left_hip"),  # Drake drops a zero-effort transmission
 ])
 def test_a_motor_without_a_torque_limit_is_refused_by_name(tmp_path, value, match):
     from pydrake.systems.framework import DiagramBuilder

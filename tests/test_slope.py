@@ -131,3 +131,14 @@ def test_slope_story_on_a_short_setting(tmp_path):
 
 def test_moving_average_skips_missing_values():
     np.testing.assert_allclose(moving_average([np.nan, 1.0, np.nan, 3.0], 2), [np.nan, 1.0, 1.0, 3.0])
+
+
+def test_a_run_shorter_than_the_moving_average_has_no_first_full_average():
+    """With fewer episodes than the 20-episode average, no average is full: none is reported, and the table
+    says why, not "episode 1"."""
+    from drake_biped.experiments.slope import _first_full, trial_summary
+
+    episodes = [{"distance_m": 10.0, "fell": False, "t1": 0.3, "t2": 0.6, "mean_t1": 0.3, "mean_t2": 0.6}] * 2
+    s = trial_summary(episodes, 10.0)
+    assert s["first_full_average_episode"] is None
+    assert _first_full(None, 2) == "— (fewer than 20 episodes)"

@@ -19,7 +19,7 @@ from typing import Any
 from drake_biped.analysis.learner_comparison import RUNNING, best_walking_window, compare
 from drake_biped.analysis.series import signed_percent
 from drake_biped.paper import GARB_MEAN_S, GARB_VARIANCE_S2
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import read_json, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -81,6 +81,7 @@ def check(settings: CompareSettings, out: Path) -> None:
 def run(settings: CompareSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """Run (or resume) every learner on `client` (a LocalCluster when None); write compare.json, .md and
     .png into `out`; return the record."""
+    check_settings(settings, CompareSettings, "compare_learners.run")
     from drake_biped.analysis.figures import learner_comparison_figure
     from drake_biped.experiments import learning
     from drake_biped.experiments.executor import client_or_local

@@ -23,6 +23,8 @@ from typing import Any
 from drake_biped.params import ParameterError
 
 SCHEDULER_TIMEOUT = "10s"
+# How long a scheduler may be without a worker before the run says so and stops (s).
+WORKER_WAIT_S = 10.0
 _ADDRESS = re.compile(r"^(tcp|tls|inproc|ucx)://[^\s/]+(:\d+)?$")
 # A local worker is one process running one CPU-bound episode at a time (a Drake diagram of its own, a few
 # hundred MB): more than this many per core only adds memory and switching. A scheduler's workers are that
@@ -86,6 +88,12 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, force:
             raise ParameterError(f"--scheduler {scheduler}: no Dask scheduler answered within "
                                  f"{SCHEDULER_TIMEOUT} ({type(exc).__name__}); start one (dask scheduler) or "
                                  "check the address") from None
+        try:
+            client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+        except (OSError, TimeoutError):
+            client.close()
+            raise ParameterError(f"--scheduler {scheduler}: the scheduler answers but has no workers (none joined "
+                                 f"within {WORKER_WAIT_S:g} s); start one: dask worker {scheduler}") from None
         try:
             yield client
         finally:

@@ -21,7 +21,7 @@ import numpy as np
 
 from drake_biped.analysis import floquet as fq
 from drake_biped.analysis.return_map import complex_list
-from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.params import EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -277,6 +277,7 @@ def figure(record: dict[str, Any], path: Path) -> None:
 def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
     """Compute on `client` (a LocalCluster when None); write floquet.json, floquet.md, floquet.png into
     `out`. The record."""
+    check_settings(settings, FloquetSettings, "floquet.run")
     from drake_biped.experiments.executor import client_or_local
 
     out = Path(out)

@@ -78,7 +78,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
@@ -479,6 +479,7 @@ def _generations(settings: GaitSearchSettings, first: int, desc: str, progress: 
 def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """Evolve from settings.config on `client` (a LocalCluster when None); write `search.jsonl` (one line
     per generation) and `best_config.json` (use it with --params); return the best and its score."""
+    check_settings(settings, GaitSearchSettings, "gait_search.run")
     from drake_biped.experiments.executor import client_or_local, map_ordered
 
     out = Path(out)

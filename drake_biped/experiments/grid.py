@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
-from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError
+from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import warn, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -317,6 +317,7 @@ def run(settings: GridSettings, out: Path, client=None, progress: bool = True,
         workers: int | None = None, scheduler: str | None = None) -> dict[str, Any]:
     """Run or finish the grid on `client` (a LocalCluster when None), with a progress bar and the run log
     OUT/run.json; write points.jsonl, grid.csv, grid.json, grid_slices.png, best_params.json. The record."""
+    check_settings(settings, GridSettings, "grid.run")
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.experiments.progress import RunProgress
 

@@ -9,7 +9,7 @@ from typing import Any
 
 from drake_biped.analysis.landscape import WindowRewards, landscape
 from drake_biped.analysis.series import signed_percent
-from drake_biped.params import ParameterError
+from drake_biped.params import ParameterError, check_settings
 from drake_biped.records import write_atomic
 from drake_biped.versions import versions
 
@@ -34,6 +34,7 @@ class LandscapeSettings:
 
 def run(settings: LandscapeSettings, out: Path | None = None, client=None, progress: bool = True) -> dict[str, Any]:
     """Write landscape.json and landscape.png into `out` (default: the window map's folder); the record."""
+    check_settings(settings, LandscapeSettings, "landscape.run")
     from drake_biped.analysis.figures import landscape_figure
 
     path = settings.path()

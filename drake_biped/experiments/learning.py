@@ -34,8 +34,12 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.rewalks import measured_cost
 from drake_biped.analysis.reward import reward
-from drake_biped.experiments.rewalk import rewalk, window_of
+from drake_biped.experiments.rewalk import REWALK_M, rewalk, window_of
+
+# The paper's episode: walk 10 m (a run with shorter episodes is a small one, re-walked at its own length).
+PAPER_EPISODE_M = 10.0
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.registry import learner_from_state, make_learner
 from drake_biped.paper import (
@@ -362,23 +366,50 @@ def run_learning(
     return trials, new
 
 
-def evaluate(settings: dict[str, Any], trials: list[Trial], client) -> dict[str, Any]:
+def evaluate(settings: dict[str, Any], trials: list[Trial], client, rewalk_distance_m: float = REWALK_M
+             ) -> dict[str, Any]:
     """Table V's measured rows: the gait without a window, and with each trial's final policy mean; and every
     one of them re-walked with the plant step halved and from 0.95 and 1.05 x the initiation speed
     (`drake_biped.experiments.rewalk`), as "rewalks"."""
     base = EpisodeConfig.from_dict(settings["config"])
     means = [{"trial": t.index, "t1": float(t.learner.mean[0]), "t2": float(t.learner.mean[1])} for t in trials]
-    rewalks = rewalk(base, means, client)
-    no_window = rewalks["no_window"]["as_learned"]
-    learned = [dict(t["walks"]["as_learned"], trial=t["trial"], t1=t["t1"], t2=t["t2"]) for t in rewalks["trials"]]
-    walked = [r["cost_of_transport"] for r in learned if not r["fell"] and r["cost_of_transport"]]
-    out = {"no_window": no_window, "learned": learned}
-    if walked and no_window["cost_of_transport"] and not no_window["fell"]:
+    rewalks = rewalk(base, means, client, distance_m=rewalk_distance_m)
+    no_window = _as_measured(rewalks["no_window"]["as_learned"])
+    learned = [dict(_as_measured(t["walks"]["as_learned"]), trial=t["trial"], t1=t["t1"], t2=t["t2"])
+               for t in rewalks["trials"]]
+    walked = [measured_cost(r) for r in learned if not r["fell"] and measured_cost(r)]
+    measure = (f"long-run C_mt of {rewalks['distance_m']:g} m walks after the first 10 m"
+               if rewalks["distance_m"] >= REWALK_M else f"C_mt of {rewalks['distance_m']:g} m walks")
+    out = {"measure": measure,
+           "no_window": no_window, "learned": learned}
+    if walked and measured_cost(no_window) and not no_window["fell"]:
         out["learned_mean_cost_of_transport"] = float(np.mean(walked))
         out["learned_std_cost_of_transport"] = float(np.std(walked))
-        out["reduction"] = 1.0 - out["learned_mean_cost_of_transport"] / no_window["cost_of_transport"]
+        out["reduction"] = 1.0 - out["learned_mean_cost_of_transport"] / measured_cost(no_window)
     out["learned_walks"] = len(walked)
     out["rewalks"] = rewalks
+    out["episode"] = _episode_measure(base, means, client)
+    return out
+
+
+def _as_measured(row: dict[str, Any]) -> dict[str, Any]:
+    """A re-walk's row with its long-run C_mt as "cost_of_transport" (the whole walk's kept beside it)."""
+    return {**row, "episode_cost_of_transport": row["cost_of_transport"], "cost_of_transport": measured_cost(row)}
+
+
+def _episode_measure(base: EpisodeConfig, means: list[dict[str, Any]], client) -> dict[str, Any]:
+    """The paper's measure beside the long-run one: the gait without a window and each trial's final policy
+    mean walked one learning episode's distance (its C_mt over the whole walk, initiation included)."""
+    from drake_biped.experiments.executor import episode_task, map_ordered
+
+    configs = [base.replace(window=TorqueFreeWindow())] + [base.replace(window=window_of((m["t1"], m["t2"])))
+                                                          for m in means]
+    results = map_ordered(client, episode_task, [c.to_dict() for c in configs])
+    costs = [None if r["fell"] else r["cost_of_transport"] for r in results]
+    walked = [c for c in costs[1:] if c]
+    out = {"distance_m": base.sim.distance_m, "no_window": costs[0], "learned": costs[1:]}
+    if walked and costs[0]:
+        out["reduction"] = 1.0 - float(np.mean(walked)) / costs[0]
     return out
 
 
@@ -419,11 +450,14 @@ class LearningSettings:
 
 
 def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, progress: bool = True,
-        workers: int | None = None, scheduler: str | None = None) -> dict[str, Any]:
+        workers: int | None = None, scheduler: str | None = None, rewalk_distance_m: float | None = None
+        ) -> dict[str, Any]:
     """Run or resume the learning on `client` (a LocalCluster when None), evaluate the final policies, and
     write learning.json, run.json, fig4_reward.png, fig5_cmt.png, fig6_times.png and table_v.md into `out`.
     `settings`: a LearningSettings, or the record dictionary of one. workers/scheduler: what run.json
-    records of the cluster. Returns the learning record."""
+    records of the cluster. `rewalk_distance_m`: how far the final policy means are re-walked (their long-run
+    C_mt is measured from REWALK_M on); None: REWALK_M, or the episodes' own distance when that is under the
+    paper's 10 m (a small run). Returns the learning record."""
     from drake_biped.analysis.figures import learning_figures
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.experiments.progress import RunProgress
@@ -436,7 +470,10 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
         with client_or_local(client) as c:
             trials, new = run_learning(out, record_settings, c, report)
             report.log.update(new, force=True)
-            evaluation = evaluate(record_settings, trials, c)
+            if rewalk_distance_m is None:
+                distance = record_settings["config"]["sim"]["distance_m"]
+                rewalk_distance_m = REWALK_M if distance >= PAPER_EPISODE_M else distance
+            evaluation = evaluate(record_settings, trials, c, rewalk_distance_m)
     finally:
         report.close()
     record = learning_record(record_settings, trials, evaluation)
@@ -493,5 +530,8 @@ def rewalk_record(source: Path, client) -> dict[str, Any]:
                    for t in record["trials"]]
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise ParameterError(f"--policy {source}: a learning record without its final means ({exc})") from None
-    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client),
+    # walked as the record's own re-walks were (a record from before re-walks were long: its episodes' length)
+    before = (record.get("evaluation") or {}).get("rewalks") or {}
+    distance = before.get("distance_m", config.sim.distance_m)
+    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client, distance),
             "versions": versions()}

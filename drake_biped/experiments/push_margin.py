@@ -21,7 +21,7 @@ from typing import Any
 
 from drake_biped.experiments.stability import CONDITIONS, condition_window, survives
 from drake_biped.paper import PUSH_DURATION_S
-from drake_biped.params import EpisodeConfig, ParameterError, Push
+from drake_biped.params import EpisodeConfig, ParameterError, Push, check_settings
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -212,6 +212,7 @@ def figure(record: dict[str, Any], path: Path) -> None:
 def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """The survival maps on `client` (a LocalCluster when None); writes push_margin.json, push_margin.md and
     push_margin.png into `out`. The record."""
+    check_settings(settings, PushMarginSettings, "push_margin.run")
     from drake_biped.experiments.executor import client_or_local
 
     out = Path(out)

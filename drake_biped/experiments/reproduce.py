@@ -45,6 +45,7 @@ from drake_biped.params import (
     InitialConditions,
     ParameterError,
     TorqueFreeWindow,
+    check_settings,
     config_of_record,
 )
 from drake_biped.records import read_json, read_kept, write_atomic
@@ -86,6 +87,7 @@ class Profile:
     floquet_newton_iterations: int = 6  # Newton's iterations towards each orbit (FloquetSettings' default)
     floquet_gaits: tuple[str, ...] = ("none", "learned")  # whose orbits: no window, the learned window
     steps: tuple[str, ...] = ()  # the steps run, in Reproduction.STEPS' order (empty: all of them)
+    rewalk_distance_m: float = 10.0  # learned windows re-walked this far (110: a long-run mean after 10 m)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -101,7 +103,7 @@ QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25
 # two learning runs (31 min) and the Table IV grid (10 min) (docs/RESULTS.md, its steps counted one by one; the
 # same steps took 2.0-2.5 x as long on another 2-core machine).
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 5.0, (2, 100), True,
-               (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 80.0, compare=(5, 300))
+               (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 80.0, compare=(5, 300), rewalk_distance_m=110.0)
 
 
 class Reproduction:
@@ -321,14 +323,19 @@ class Reproduction:
 
         settings = learning.LearningSettings(config or self.level, trials, episodes, 0, mean=mean,
                                              variance=variance).record()
+        distance = self.profile.rewalk_distance_m
 
         def run(folder: Path) -> dict:
-            record = learning.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler)
+            record = learning.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler,
+                                  rewalk_distance_m=distance)
             ev = record["evaluation"]
             run_log = read_json(folder / "run.json", "reproduce")
             return {"evaluation": ev, "episodes_per_min": run_log["episodes_per_min"]}
 
-        return self.experiment(name, {k: settings[k] for k in ("trials", "episodes", "learner", "config")}, run)
+        kept = {k: settings[k] for k in ("trials", "episodes", "learner", "config")}
+        if distance != 10.0:  # the re-walks' length decides the evaluation (10 m: as before they were long)
+            kept["rewalk_distance_m"] = distance
+        return self.experiment(name, kept, run)
 
     def learn(self) -> dict:
         trials, episodes = self.profile.learn
@@ -525,6 +532,7 @@ def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = Tr
     """Every experiment into its folder of `out` on `client` (a LocalCluster when None), then report.md,
     report.html and report_summary.png; reuses finished experiments and resumes the unfinished one. The
     experiments' summaries."""
+    check_settings(settings, ReproduceSettings, "reproduce.run")
     from drake_biped.experiments.executor import client_or_local
 
     out = Path(out)

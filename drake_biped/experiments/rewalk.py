@@ -11,8 +11,12 @@ from __future__ import annotations
 
 from typing import Any
 
+from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
 from drake_biped.analysis.rewalks import CHANGES, KEEP, summary
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, TorqueFreeWindow
+
+# A re-walk's length: the initiation's transient, then the long-run mean's span.
+REWALK_M = TRANSIENT_M + LONG_RUN_M
 
 __all__ = ["changed", "rewalk", "window_of"]
 
@@ -35,12 +39,15 @@ def changed(config: EpisodeConfig, change: str) -> EpisodeConfig:
     raise ParameterError(f"re-walk change {change!r} is not one of {list(CHANGES)}")
 
 
-def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client) -> dict[str, Any]:
+def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
+           distance_m: float = REWALK_M) -> dict[str, Any]:
     """Walk each learned window (`learned`: {"trial", "t1", "t2"}, a policy mean, per trial) and the gait
-    without a window, as learned and under each change, on the Dask `client`: the `summary` record."""
+    without a window, as learned and under each change, `distance_m` each (the long-run C_mt is measured after
+    the first 10 m), on the Dask `client`: the `summary` record."""
     from drake_biped.experiments.executor import episode_task
 
-    plain = config.replace(window=TorqueFreeWindow())
+    plain = config.replace(window=TorqueFreeWindow()).override(
+        {"sim.distance_m": distance_m, "sim.max_time_s": max(config.sim.max_time_s, 6.0 * distance_m)})
     jobs: dict[tuple[str, Any], dict[str, Any]] = {}
     for change in CHANGES:
         base = changed(plain, change)
@@ -54,7 +61,12 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client) -> dict
     rows: dict[str, dict[Any, dict[str, Any]]] = {change: {} for change in CHANGES}
     for (change, key), r in results.items():
         rows[change][key] = {f: r[f] for f in KEEP}
+        if distance_m >= REWALK_M:  # long enough for a long-run mean: the saving is of it
+            long_run = long_run_of_record(r, GRAVITY_MPS2)
+            rows[change][key].update(long_run_cost_of_transport=long_run["cost_of_transport"],
+                                     long_run_half_width=long_run["half_width"],
+                                     step_period_std_s=long_run["step_period_std_s"])
     for change in CHANGES:
         for t in learned:
             rows[change].setdefault(t["trial"], rows[change]["no_window"])
-    return summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows)
+    return {**summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows), "distance_m": distance_m}

@@ -39,7 +39,7 @@ from drake_biped.experiments.learning import make_settings, run_learning, trial_
 from drake_biped.experiments.rewalk import changed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
-from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -123,7 +123,8 @@ def trial_summary(episodes: list[dict[str, Any]], distance_m: float) -> dict[str
     up = np.array([(not e["fell"]) and e["distance_m"] >= distance_m - 1e-6 for e in episodes])
     n = min(MOVING_AVERAGE, len(episodes))
     ma = moving_average(d, MOVING_AVERAGE)
-    reached = np.flatnonzero(ma >= distance_m - 1e-6)
+    # only a full window of MOVING_AVERAGE episodes counts: the first averages hold fewer
+    reached = np.flatnonzero(ma[MOVING_AVERAGE - 1:] >= distance_m - 1e-6) + (MOVING_AVERAGE - 1)
     return {
         "episodes": len(episodes),
         "period_first_s": float(p[:n].mean()),
@@ -246,11 +247,17 @@ def report_markdown(record: dict[str, Any]) -> str:
         lines.append(
             f"| {t['trial']} | {t['episodes']} | {t['period_first_s']:.3f} / {t['period_last_s']:.3f} | "
             f"{t['mean_period_end_s']:.3f} | {t['distance_first_m']:.2f} / {t['distance_last_m']:.2f} | "
-            f"{100 * t['climb_share_last']:.0f} % | {'never' if first is None else f'episode {first}'} | "
+            f"{100 * t['climb_share_last']:.0f} % | {_first_full(first, t['episodes'])} | "
             f"({t['final_mean'][0]:.3f}, {t['final_mean'][1]:.3f}): {episode(t['final_policy'])} |")
     lines += ["", "Figures: fig8_period.png (the paper's Fig. 8, or Fig. 10 at 2.0°), fig9_distance.png "
               "(Fig. 9 / Fig. 11).", ""]
     return "\n".join(lines)
+
+
+def _first_full(first: int | None, episodes: int) -> str:
+    if episodes < MOVING_AVERAGE:
+        return f"— (fewer than {MOVING_AVERAGE} episodes)"
+    return "never" if first is None else f"episode {first}"
 
 
 @dataclass(frozen=True)
@@ -288,6 +295,7 @@ def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
         workers: int | None = None, scheduler: str | None = None) -> dict[str, Any]:
     """The checks and the online learning on `client` (a LocalCluster when None), with a progress bar and
     OUT/run.json; writes slope.json, report.md, fig8_period.png, fig9_distance.png, checks/, trials/."""
+    check_settings(settings, SlopeSettings, "slope.run")
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.experiments.progress import RunProgress
 

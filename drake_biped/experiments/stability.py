@@ -26,7 +26,14 @@ import numpy as np
 
 from drake_biped.analysis.return_map import complex_list, fit_return_map, least_squares_map
 from drake_biped.paper import TABLE_VI
-from drake_biped.params import EpisodeConfig, InitialConditions, ParameterError, Push, TorqueFreeWindow
+from drake_biped.params import (
+    EpisodeConfig,
+    InitialConditions,
+    ParameterError,
+    Push,
+    TorqueFreeWindow,
+    check_settings,
+)
 from drake_biped.versions import versions
 
 CONDITIONS = ("without", "with")
@@ -301,6 +308,7 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     report.md and report.html into `out`. `floquet`: also the periodic orbit's Floquet multipliers without
     and with the window (experiments/floquet.py; floquet_without/, floquet_with/ and a report section). The
     record."""
+    check_settings(settings, StabilitySettings, "stability.run")
     from drake_biped.analysis.stability_report import write_stability_outputs
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.records import write_atomic

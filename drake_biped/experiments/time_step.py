@@ -21,10 +21,17 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_cost
+from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
-from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, TorqueFreeWindow, with_time_step
+from drake_biped.params import (
+    GRAVITY_MPS2,
+    EpisodeConfig,
+    ParameterError,
+    TorqueFreeWindow,
+    check_settings,
+    with_time_step,
+)
 from drake_biped.records import read_json, save_figure, write_text_atomic
 from drake_biped.versions import versions
 
@@ -80,11 +87,7 @@ def study(steps: list[float], reference: float, distance: float, client, progres
 
 
 def _long_run(result: dict) -> dict:
-    """analysis.long_run.long_run_cost of an episode's record (its touchdowns)."""
-    steps = result["steps"]
-    work = [math.nan if s.get("positive_work_j") is None else s["positive_work_j"] for s in steps]
-    return long_run_cost([s["touchdown_time_s"] for s in steps], [s["com_x_m"] for s in steps], work,
-                         result["mass_kg"], GRAVITY_MPS2)
+    return long_run_of_record(result, GRAVITY_MPS2)
 
 
 def richardson(rows: list[dict], steps: list[float], window) -> dict:
@@ -306,6 +309,7 @@ class TimeStepSettings:
 def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = True) -> dict:
     """Run the study on `client` (a LocalCluster when None); write time_step_study.json, .md and .png into
     `out`; return the record."""
+    check_settings(settings, TimeStepSettings, "time_step.run")
     from drake_biped.experiments.executor import client_or_local
 
     out = Path(out)

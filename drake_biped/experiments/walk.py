@@ -13,7 +13,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
-from drake_biped.params import EpisodeConfig
+from drake_biped.params import EpisodeConfig, check_settings
 from drake_biped.records import warn, write_text_atomic
 
 
@@ -119,6 +119,7 @@ class WalkSettings:
 def run(settings: WalkSettings, out: Path, client=None, progress: bool = True):
     """Walk one episode (in this process: Meshcat records it; `client` is not used) and write its files into
     `out` (see `write_walk`), with a progress bar in metres. The EpisodeResult."""
+    check_settings(settings, WalkSettings, "walk.run")
     update, bars = None, []
     if progress:
         from tqdm import tqdm

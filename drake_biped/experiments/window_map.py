@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,11 +16,14 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.series import signed_percent
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["WindowMapSettings", "evaluate_windows", "run", "summary_lines", "window_grid"]
+# The most windows a map runs without force=True (--force): every one an episode held in memory before the first.
+MAX_WINDOWS = 20_000
+
+__all__ = ["MAX_WINDOWS", "WindowMapSettings", "evaluate_windows", "run", "summary_lines", "window_grid"]
 
 
 @dataclass(frozen=True)
@@ -32,11 +36,28 @@ class WindowMapSettings:
     t1_step_s: float = 0.1
     t2_step_s: float = 0.1
     min_length_s: float = 0.1
+    force: bool = False  # run a map over MAX_WINDOWS windows
 
     def __post_init__(self) -> None:
+        n = self.window_count()
+        if n > MAX_WINDOWS and not self.force:
+            raise ParameterError(f"window map: --t1-max {self.t1_max_s:g} --t2-max {self.t2_max_s:g} --step "
+                                 f"{self.t1_step_s:g} gives {n:,} windows, more than the limit of {MAX_WINDOWS:,} "
+                                 "(each an episode); give a coarser --step, or --force to run it anyway")
         if not self.windows():
             raise ParameterError(f"--t1-max {self.t1_max_s:g} --t2-max {self.t2_max_s:g} --step {self.t1_step_s:g}: "
                                  f"no window fits (t2 runs from t1 + {self.min_length_s:g} s up to --t2-max)")
+
+    def window_count(self) -> int:
+        """How many windows the grid holds, counted without building it."""
+        if not all(math.isfinite(x) and x > 0 for x in (self.t1_step_s, self.t2_step_s)):
+            raise ParameterError(f"window map: the steps must be positive, got {self.t1_step_s!r}, {self.t2_step_s!r}")
+        count = 0
+        for k in range(int(math.floor(self.t1_max_s / self.t1_step_s + 1e-9)) + 1):
+            span = self.t2_max_s - k * self.t1_step_s - self.min_length_s
+            if span >= -1e-9:
+                count += int(math.floor(span / self.t2_step_s + 1e-9)) + 1
+        return count
 
     def windows(self) -> list[tuple[float, float]]:
         return window_grid(self.t1_max_s, self.t2_max_s, self.t1_step_s, self.t2_step_s, self.min_length_s)
@@ -75,21 +96,43 @@ def window_row(config: dict[str, Any]) -> dict[str, Any]:
 
 
 def evaluate_windows(config: EpisodeConfig, windows: list[tuple[float, float]], client,
-                     progress: bool = True) -> tuple[dict, list[dict]]:
-    """The no-window baseline and one row per window, on the Dask `client`."""
-    from drake_biped.experiments.executor import map_ordered
+                     progress: bool = True, keep: Path | None = None) -> tuple[dict, list[dict]]:
+    """The no-window baseline and one row per window, on the Dask `client`. `keep`: a JSON-lines file each
+    finished row is appended to as it comes (an interrupted map loses no finished episode) and read back from
+    when the same map runs again."""
+    from distributed import as_completed
+
+    from drake_biped.experiments.executor import DrakeGuarded
 
     configs = [config.replace(window=TorqueFreeWindow(0.0, 0.0))]
     configs += [config.replace(window=TorqueFreeWindow(t1, t2)) for t1, t2 in windows]
+    dicts = [c.to_dict() for c in configs]
+    rows: list[dict | None] = [None] * len(configs)
+    kept = _read_kept_rows(keep)
+    for i, c in enumerate(dicts):
+        rows[i] = kept.get(json.dumps(c, sort_keys=True))
+    todo = [i for i, r in enumerate(rows) if r is None]
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(configs), desc="windows", unit="episode")
+        bar = tqdm(total=len(configs), initial=len(configs) - len(todo), desc="windows", unit="episode")
+    sink = open(keep, "a") if keep is not None else None
+    if sink is not None and sink.tell() > 0 and not Path(keep).read_text().endswith("\n"):
+        sink.write("\n")  # a line torn by a kill ends here; the rows after it start on their own line
     try:
-        rows = map_ordered(client, window_row, [c.to_dict() for c in configs],
-                           progress=(lambda done, _: bar.update(1)) if bar is not None else None)
+        futures = {client.submit(DrakeGuarded(window_row), dicts[i], pure=False): i for i in todo}
+        for future in as_completed(list(futures)):
+            i = futures[future]
+            rows[i] = future.result()
+            if sink is not None:
+                sink.write(json.dumps({"config": dicts[i], "row": rows[i]}, sort_keys=True) + "\n")
+                sink.flush()
+            if bar is not None:
+                bar.update(1)
     finally:
+        if sink is not None:
+            sink.close()
         if bar is not None:
             bar.close()
     baseline, rows = rows[0], rows[1:]
@@ -99,9 +142,25 @@ def evaluate_windows(config: EpisodeConfig, windows: list[tuple[float, float]], 
     return baseline, rows
 
 
+def _read_kept_rows(path: Path | None) -> dict[str, dict]:
+    """The rows kept in `path` by configuration (its sorted JSON); a torn last line (a kill mid-write) is
+    dropped."""
+    if path is None or not Path(path).is_file():
+        return {}
+    out = {}
+    for line in Path(path).read_text().splitlines():
+        try:
+            entry = json.loads(line)
+            out[json.dumps(entry["config"], sort_keys=True)] = entry["row"]
+        except (ValueError, KeyError, TypeError):
+            continue
+    return out
+
+
 def run(settings: WindowMapSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """Evaluate the grid on `client` (a LocalCluster when None); write window_map.json, window_map.csv and
     window_map.png into `out`; return the record."""
+    check_settings(settings, WindowMapSettings, "window_map.run")
     from drake_biped.analysis.figures import window_map_figure
     from drake_biped.experiments.executor import client_or_local
 
@@ -109,7 +168,7 @@ def run(settings: WindowMapSettings, out: Path, client=None, progress: bool = Tr
     out.mkdir(parents=True, exist_ok=True)
     config = settings.config
     with client_or_local(client) as c:
-        baseline, rows = evaluate_windows(config, settings.windows(), c, progress)
+        baseline, rows = evaluate_windows(config, settings.windows(), c, progress, keep=out / "episodes.jsonl")
     record = {"config": config.to_dict(), "baseline": baseline, "windows": rows, "versions": versions()}
     write_text_atomic(out / "window_map.json", json.dumps(record, indent=2) + "\n")
     text = io.StringIO(newline="")

@@ -1,0 +1,171 @@
+"""Output folders hold one run's records: another command or other settings are refused (or replaced with
+--overwrite), one process at a time writes a folder, and finished work survives an interruption. Sizes are
+bounded before any work; a cluster without workers is said within seconds; the API names wrong arguments."""
+
+import json
+import threading
+
+import pytest
+
+from drake_biped.cli import main
+from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.records import LOCK_FILE, RUN_FILE, claim_folder
+
+
+def test_a_folder_is_held_by_one_run_and_refused_to_another_naming_both(tmp_path):
+    out = tmp_path / "run"
+    with claim_folder(out, "walk", {"t1": 0.3}):
+        (out / "result.json").write_text("{}")
+        with pytest.raises(ParameterError, match=r"another run is writing this folder \(process \d+: drake-biped walk"):
+            with claim_folder(out, "walk", {"t1": 0.3}):
+                pass
+    assert json.loads((out / RUN_FILE).read_text()) == {"command": "walk", "settings": {"t1": 0.3}}
+    assert not (out / LOCK_FILE).exists() or (out / LOCK_FILE).read_text()
+    with claim_folder(out, "walk", {"t1": 0.3}):  # the same run again: a resume
+        pass
+    with pytest.raises(ParameterError, match=r"holds the records of another run \(drake-biped walk with other "
+                                             r"settings: --t1 0.3 there, 0.4 here\): .*--overwrite"):
+        with claim_folder(out, "walk", {"t1": 0.4}):
+            pass
+    with pytest.raises(ParameterError, match=r"another run \(drake-biped walk; this run is drake-biped grid\)"):
+        with claim_folder(out, "grid", {"t1": 0.3}):
+            pass
+    assert (out / "result.json").exists()  # nothing of the first run was touched
+    with claim_folder(out, "walk", {"t1": 0.4}, overwrite=True):
+        assert not (out / "result.json").exists()  # replaced: the old records are gone
+    assert json.loads((out / RUN_FILE).read_text())["settings"] == {"t1": 0.4}
+
+
+def test_a_refused_run_leaves_a_new_folder_as_it_found_it(tmp_path):
+    out = tmp_path / "fresh"
+    with pytest.raises(RuntimeError):
+        with claim_folder(out, "walk", {}):
+            raise RuntimeError("input refused inside the command")
+    assert list(out.iterdir()) == []
+
+
+def test_a_second_command_into_a_busy_folder_is_refused_and_the_first_finishes_whole(tmp_path, capsys):
+    out = tmp_path / "w"
+    started, release = threading.Event(), threading.Event()
+    codes = {}
+
+    def first():
+        import drake_biped.cli as cli
+
+        real = cli.cmd_walk
+
+        def slow(args):
+            started.set()
+            release.wait(30)
+            return real(args)
+
+        cli_args = ["walk", "--distance", "0.3", "--no-animation", "--out", str(out)]
+        parser_func = cli.build_parser().parse_args(cli_args)
+        parser_func.func = slow
+        with cli._holding_the_out_folder(parser_func):
+            codes["first"] = parser_func.func(parser_func)
+
+    thread = threading.Thread(target=first)
+    thread.start()
+    assert started.wait(30)
+    with pytest.raises(SystemExit) as second:
+        main(["walk", "--distance", "0.3", "--no-animation", "--out", str(out)])
+    release.set()
+    thread.join(60)
+    assert second.value.code == 2
+    err = [line for line in capsys.readouterr().err.strip().splitlines() if line.startswith("drake-biped")]
+    assert len(err) == 1 and "another run is writing this folder" in err[0] and "drake-biped walk" in err[0]
+    assert codes["first"] == 0 and json.loads((out / "result.json").read_text())["distance_m"] >= 0.3
+
+
+def test_walk_into_another_walks_folder_is_refused_before_any_work(tmp_path, capsys):
+    out = tmp_path / "w"
+    assert main(["walk", "--distance", "0.3", "--no-animation", "--out", str(out)]) == 0
+    first = (out / "result.json").read_text()
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as e:
+        main(["walk", "--distance", "0.3", "--t1", "0.2", "--t2", "0.5", "--no-animation", "--save-trajectory",
+              "--out", str(out)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "holds the records of another run" in err[0] and "--overwrite" in err[0]
+    assert (out / "result.json").read_text() == first
+    assert main(["walk", "--distance", "0.3", "--no-animation", "--out", str(out), "--overwrite"]) == 0
+    assert not (out / "trajectory.npz").exists()
+
+
+def test_a_window_map_beyond_its_limit_is_refused_before_any_work(tmp_path, capsys):
+    from drake_biped.experiments.window_map import MAX_WINDOWS, WindowMapSettings
+
+    with pytest.raises(ParameterError, match=r"gives 301,101 windows, more than the limit of 20,000"):
+        WindowMapSettings(t1_step_s=0.001, t2_step_s=0.001)
+    assert WindowMapSettings(t1_step_s=0.001, t2_step_s=0.001, force=True).window_count() == 301_101 > MAX_WINDOWS
+    assert WindowMapSettings().window_count() == len(WindowMapSettings().windows())
+    with pytest.raises(SystemExit) as e:
+        main(["window-map", "--step", "0.001", "--distance", "0.3", "--out", str(tmp_path / "m")])
+    assert e.value.code == 2 and "301,101 windows" in capsys.readouterr().err
+    assert not (tmp_path / "m").exists()
+
+
+def test_a_window_map_keeps_every_finished_episode_and_reads_them_back(tmp_path, client):
+    """Each finished row is appended as it comes: a map run again over a kept file runs only what is missing,
+    and a torn last line is run again."""
+    from drake_biped.experiments import window_map
+
+    config = EpisodeConfig().override({"sim.distance_m": 0.3})
+    keep = tmp_path / "episodes.jsonl"
+    windows = [(0.1, 0.3), (0.2, 0.4)]
+    baseline, rows = window_map.evaluate_windows(config, windows, client, progress=False, keep=keep)
+    lines = keep.read_text().splitlines()
+    assert len(lines) == 3
+    keep.write_text("\n".join(lines[:2]) + "\n" + lines[2][:25])  # the last one torn by a kill
+    calls = []
+    real = window_map.window_row
+
+    def counting(c):
+        calls.append(c)
+        return real(c)
+
+    window_map.window_row = counting
+    try:
+        again = window_map.evaluate_windows(config, windows, client, progress=False, keep=keep)
+    finally:
+        window_map.window_row = real
+    assert again == (baseline, rows)
+    assert len(keep.read_text().splitlines()) == 4
+
+
+def test_a_scheduler_without_workers_is_said_within_seconds(monkeypatch):
+    from distributed import LocalCluster
+
+    from drake_biped.experiments import executor
+
+    monkeypatch.setattr(executor, "WORKER_WAIT_S", 1.0)
+    with LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) as cluster:
+        with pytest.raises(ParameterError, match=r"--scheduler .*has no workers \(none joined within 1 s\); start "
+                                                 r"one: dask worker"):
+            with executor.dask_client(scheduler=cluster.scheduler_address):
+                pass
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: EpisodeConfig().override({"seed": 1}).seed == 1 or None, None),
+    (lambda: __import__("drake_biped.episode", fromlist=["x"]).run_episode(EpisodeConfig(), cache="x"),
+     r"run_episode: cache must be a DiagramCache or None, got str 'x'"),
+    (lambda: __import__("drake_biped.episode", fromlist=["x"]).run_episode("default"),
+     r"run_episode: config must be an EpisodeConfig"),
+    (lambda: __import__("drake_biped.model", fromlist=["x"]).body_of_model("x"),
+     r"body_of_model: model must be a RobotModel"),
+    (lambda: __import__("drake_biped.experiments.window_map", fromlist=["x"]).run({"t1_max_s": 0.3}, "never", None),
+     r"window_map.run: settings must be a WindowMapSettings, got dict"),
+    (lambda: __import__("drake_biped.experiments.grid", fromlist=["x"]).run({}, "never", None),
+     r"grid.run: settings must be a GridSettings, got dict"),
+])
+def test_the_api_names_a_wrong_argument(tmp_path, monkeypatch, call, match):
+    monkeypatch.chdir(tmp_path)
+    if match is None:
+        assert call()
+        return
+    with pytest.raises(ParameterError, match=match):
+        call()
+    assert not (tmp_path / "never").exists()
