@@ -37,9 +37,6 @@ import numpy as np
 from drake_biped.analysis.rewalks import measured_cost
 from drake_biped.analysis.reward import reward
 from drake_biped.experiments.rewalk import REWALK_M, rewalk, window_of
-
-# The paper's episode: walk 10 m (a run with shorter episodes is a small one, re-walked at its own length).
-PAPER_EPISODE_M = 10.0
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.registry import learner_from_state, make_learner
 from drake_biped.paper import (
@@ -53,6 +50,9 @@ from drake_biped.paper import (
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, config_of_record
 from drake_biped.records import read_json, write_atomic
 from drake_biped.versions import versions
+
+# The paper's episode: walk 10 m (a run with shorter episodes is a small one, re-walked at its own length).
+PAPER_EPISODE_M = 10.0
 
 __all__ = ["LearningSettings", "Trial", "best_learned_trial", "check_learning_record", "make_settings", "reward", "run", "run_learning",
            "summary_lines"]
