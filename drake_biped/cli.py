@@ -661,7 +661,9 @@ def build_parser() -> argparse.ArgumentParser:
                              "walk as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, "
                              "of every hip-off-until-touchdown window t1 0.30-0.56 s within the learner's reach (the "
                              "best reward's plateau, and 0.36-0.48 s where GARB's means have ended) and 0.02 s "
-                             "around it)")
+                             "around it), 'hold-long' ('robust' first, then the smallest long-run C_mt saving of "
+                             "t1 0.36, 0.40, 0.44, 0.48 s until touchdown over 40 m walks, as they are, at half the "
+                             "step and from 0.95 and 1.05 x the initiation speed)")
     search.add_argument("--policy-draws", type=_count, default=12,
                         help="draws of the paper's start policy the 'policy', 'expected' and 'story' objectives walk "
                              "(default 12; a draw with t2 <= t1 is no window and costs no episode)")

@@ -57,7 +57,11 @@ walks, by the objective:
   of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the
   smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus
   0.1 x the mean over HOLD_WINDOWS of each window's smallest reward gain (a wider slope that holds), minus
-  0.01 d / (1 + d) as in "story".
+  0.01 d / (1 + d) as in "story";
+- "hold-long": the "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the
+  foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation
+  speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m:
+  the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
@@ -144,7 +148,7 @@ COAST_MUTATIONS = {
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
                  "coast": COAST_MUTATIONS}
 OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape", "robust", "story",
-              "hold")
+              "hold", "hold-long")
 # The "robust" objective's changes to the walk without a window, and the half step's allowed C_mt change.
 ROBUST_CHECKS = ("half_step", "speed_0.95", "speed_1.05", "push_forward", "push_backward")
 ROBUST_CMT_CHANGE = 0.02
@@ -157,6 +161,12 @@ HOLD_PLATEAU, HOLD_MARGIN_S = 0.05, 0.02
 # t1 of the means GARB with the paper's settings ended on: 0.37-0.45 s on hold-g1 (reward peak 0.32 s) and
 # 0.41-0.47 s on cand1 (benchmarks/results/learn-*); 0.30-0.53 s on coasting_wide at 0.5 ms.
 HOLD_BAND = (0.36, 0.48)
+# The "hold-long" objective: windows across HOLD_BAND (hip off from t1 until the foot lands), each walked
+# HOLD_LONG_M and judged by its long-run C_mt after the initiation's 10 m (on the contact with a continuous
+# limit, GARB's means on the default gait ended at t1 0.37-0.44 s; those past the powered step's end, 0.43 s,
+# held in one walk and not in the next).
+HOLD_LONG_WINDOWS = ((0.36, 1.2), (0.40, 1.2), (0.44, 1.2), (0.48, 1.2))
+HOLD_LONG_M = 40.0
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -359,6 +369,42 @@ def _hold_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dic
                    "distance_from_table_iii": d}
 
 
+def _long_walk(config: EpisodeConfig) -> dict[str, Any]:
+    """A HOLD_LONG_M walk of `config`: whether it walked, and its long-run C_mt after the first 10 m."""
+    from drake_biped.episode import run_episode
+
+    r = run_episode(config.override({"sim.distance_m": HOLD_LONG_M,
+                                     "sim.max_time_s": max(config.sim.max_time_s, 6.0 * HOLD_LONG_M)}))
+    walked = (not r.fell) and r.distance_m >= HOLD_LONG_M - 1e-6
+    long_run = r.long_run(batches=4)
+    return {"walked": walked, "distance_m": r.distance_m, "cost_of_transport": long_run["cost_of_transport"]
+            if walked else None, "step_period_s": long_run["step_period_mean_s"],
+            "step_period_std_s": long_run["step_period_std_s"]}
+
+
+def _hold_long_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-long" objective (module docstring) and what it measured; `base` may be a fall."""
+    robust, detail = _robust_score(config, base)
+    if robust < 0.0:
+        return robust - 2.0, detail
+    changed = {"as_is": config, **_changed(config)}
+    bases = {name: _long_walk(c.replace(window=TorqueFreeWindow())) for name, c in changed.items()}
+    if not all(b["walked"] for b in bases.values()):
+        walked = sum(b["walked"] for b in bases.values())
+        return -1.5 + 0.1 * walked, {**detail, "long_bases": bases}
+    windows = []
+    for t1, t2 in HOLD_LONG_WINDOWS:
+        walks = {name: _long_walk(c.replace(window=TorqueFreeWindow(t1, t2))) for name, c in changed.items()}
+        windows.append({"window": [t1, t2], "walks": walks,
+                        "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
+    savings = [v for w in windows for v in w["savings"].values()]
+    least = min(savings)
+    d = distance_from_table_iii(config.cpg)
+    value = least + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
+    return value, {**detail, "long_bases": bases, "windows": windows, "least_saving": least,
+                   "distance_from_table_iii": d}
+
+
 def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows",
           draws: int = POLICY_DRAWS) -> tuple[float, dict[str, Any]]:
     """The search objective (module docstring) and what it measured; `draws`: how many draws of the start
@@ -370,6 +416,8 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
         return _story_score(config, base, draws)
     if objective == "hold":
         return _hold_score(config, base)
+    if objective == "hold-long":
+        return _hold_long_score(config, base)
     if not base["walked"]:
         return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
             {"baseline": base, "windows": []}
