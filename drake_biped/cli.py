@@ -871,6 +871,11 @@ def main(argv: list[str] | None = None) -> int:
     only with --debug or DRAKE_BIPED_DEBUG=1."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    # tqdm's monitor thread, stopped by an atexit hook, prints a traceback of its own when a second Ctrl-C
+    # arrives while the process exits; the bars need no monitor.
+    from tqdm import tqdm
+
+    tqdm.monitor_interval = 0
     debug = bool(getattr(args, "debug", False)) or os.environ.get(DEBUG_ENV, "") not in ("", "0")
     out = getattr(args, "out", None)
     again = ("run the same command again to resume: finished work is kept in " + str(out)

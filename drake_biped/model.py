@@ -36,6 +36,7 @@ from pydrake.multibody.plant import (
     MultibodyPlant,
     MultibodyPlantConfig,
 )
+from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_biped.kinematics import (
@@ -166,12 +167,32 @@ def parse_model(parser: Parser, model: RobotModel | None = None) -> None:
         if model is None:
             parser.AddModels(url=MODEL_URL)
         else:
-            parser.AddModelsFromString(model.text, model.format)
+            parser.AddModelsFromString(_with_absolute_files(model), model.format)
     except Exception as exc:  # Drake raises RuntimeError with the parser's message
         detail = " ".join(str(exc).split())
         if model is not None:  # Drake names a text it parsed "<literal-string>.urdf": name the file
             detail = detail.replace(f"<literal-string>.{model.format}", model.name)
         raise ModelError(f"could not parse the model {name}: {detail}") from exc
+
+
+def _with_absolute_files(model: RobotModel) -> str:
+    """The model's text with each relative file name (a URDF `filename="..."`, an SDFormat `<uri>`) made absolute
+    against the folder the file was read from: a text parsed from a string has no folder of its own. URIs
+    with a scheme (package://, file://) and absolute paths are kept."""
+    import re
+
+    if not model.directory:
+        return model.text
+    folder = Path(model.directory)
+
+    def absolute(value: str) -> str:
+        if "://" in value or Path(value).is_absolute() or not (folder / value).exists():
+            return value
+        return (folder / value).resolve().as_uri()
+
+    if model.format == "urdf":
+        return re.sub(r'filename="([^"]+)"', lambda m: f'filename="{absolute(m.group(1))}"', model.text)
+    return re.sub(r"<uri>\s*([^<]+?)\s*</uri>", lambda m: f"<uri>{absolute(m.group(1))}</uri>", model.text)
 
 
 # A level-then-slope ground's boxes: the level part from GROUND_BEHIND_M (behind the start) to the slope's foot,
@@ -262,6 +283,7 @@ def check_layout(plant: MultibodyPlant) -> None:
             raise ModelError(f"the model has no joint named {name!r}; expected {['floating_base', *JOINT_NAMES]}")
     for name in JOINT_NAMES:
         actuator_of(plant, name)
+    _check_every_body_rides_a_link(plant)
     if plant.num_positions() != 9 or plant.num_velocities() != 9 or plant.num_actuators() != 6:
         raise ModelError(
             f"expected 9 positions, 9 velocities and 6 actuators, got {plant.num_positions()}, "
@@ -345,6 +367,40 @@ def _check_joint_limits(plant: MultibodyPlant) -> None:
 LINKS = ("torso", *(f"{leg}_{link}" for leg in LEGS for link in ("thigh", "shank", "foot")))
 
 
+def composite(plant: MultibodyPlant, name: str) -> tuple[float, tuple[float, float]]:
+    """The mass (kg) and centre of mass (x, z in the link's frame, m) of the link `name` with every body welded
+    to it (a sensor box bolted to the torso counts in the torso): the planar kinematics knows the seven links,
+    and what hangs on them rigidly moves with them. ModelError naming a body that moves on a joint of its own."""
+    link = plant.GetBodyByName(name)
+    riders = [b for b in plant.GetBodiesWeldedTo(link)
+              if b.name() not in LINKS and b.index() != plant.world_body().index()
+              and math.isfinite(float(b.default_mass())) and float(b.default_mass()) >= 0.0]
+    if not riders:  # the link alone: its own numbers, bit for bit
+        return float(link.default_mass()), _xz(link.default_com())
+    context = plant.CreateDefaultContext()
+    total = float(link.default_mass())
+    moment = total * np.asarray(link.default_com())
+    for body in riders:
+        m = float(body.default_mass())
+        X = plant.CalcRelativeTransform(context, link.body_frame(), body.body_frame())
+        total += m
+        moment = moment + m * X.multiply(body.default_com())
+    return total, _xz(moment / total)
+
+
+def _check_every_body_rides_a_link(plant: MultibodyPlant) -> None:
+    """ModelError naming a body that is neither one of the seven links nor welded to one."""
+    if not all(plant.HasBodyNamed(name) for name in LINKS):
+        return  # link_masses_of names the missing link
+    riding = {int(b.index()) for name in LINKS for b in plant.GetBodiesWeldedTo(plant.GetBodyByName(name))}
+    for index in range(plant.num_bodies()):
+        body = plant.get_body(BodyIndex(index))
+        if index == int(plant.world_body().index()) or index in riding:
+            continue
+        raise ModelError(f"link {body.name()} moves on a joint of its own; the toolkit's planar kinematics knows "
+                         f"the seven links {list(LINKS)} and bodies welded (fixed) to them")
+
+
 def link_masses_of(plant: MultibodyPlant) -> LinkMasses:
     """The links' masses as the model file gives them; ModelError unless each is positive and the legs are
     mirror images (the controller's centre of mass takes one mass per link kind)."""
@@ -356,7 +412,7 @@ def link_masses_of(plant: MultibodyPlant) -> LinkMasses:
             raise ModelError(f"link {name} has mass {m!r} kg; every link's mass must be positive")
 
     def mass(name: str) -> float:
-        return float(plant.GetBodyByName(name).default_mass())
+        return composite(plant, name)[0]
 
     legs = {leg: tuple(mass(f"{leg}_{link}") for link in ("thigh", "shank", "foot")) for leg in LEGS}
     if legs["left"] != legs["right"]:
@@ -394,7 +450,7 @@ def _leg_geometry(plant: MultibodyPlant, scene_graph: SceneGraph, leg: str) -> d
                                  f"({pose.translation().tolist()}); put the link's frame at the joint")
         out[joint] = _xz(j.frame_on_parent().GetFixedPoseInBodyFrame().translation())
     for link in ("thigh", "shank", "foot"):
-        out[f"{link}_com"] = _xz(plant.GetBodyByName(f"{leg}_{link}").default_com())
+        out[f"{link}_com"] = composite(plant, f"{leg}_{link}")[1]
     inspector = scene_graph.model_inspector()
     spheres = []
     for geometry in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(f"{leg}_foot")):
@@ -435,7 +491,7 @@ def body_of(plant: MultibodyPlant, scene_graph: SceneGraph, tolerance_m: float =
             raise ModelError(f"the legs differ: the left {what} is {np.round(left, 6).tolist()} m, the right "
                              f"{np.round(right, 6).tolist()} m; the toolkit assumes mirror-image legs")
     g = legs["left"]
-    body = body_vector(masses, hip=g["hip"], torso_com=_xz(plant.GetBodyByName("torso").default_com()),
+    body = body_vector(masses, hip=g["hip"], torso_com=composite(plant, "torso")[1],
                        knee=g["knee"], thigh_com=g["thigh_com"], ankle=g["ankle"], shank_com=g["shank_com"],
                        foot_com=g["foot_com"], heel=g["heel"], toe=g["toe"], efforts=motor_limits(plant))
     _check_body(plant, body, tolerance_m)

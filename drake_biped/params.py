@@ -488,6 +488,8 @@ class RobotModel:
     format: str = "urdf"
     sha256: str = ""
     package_xml: str | None = None
+    # The folder the file was read from: its relative file names (meshes) resolve against it.
+    directory: str | None = None
 
     def __post_init__(self) -> None:
         if self.format not in MODEL_FORMATS.values():
@@ -514,7 +516,8 @@ class RobotModel:
         except (OSError, UnicodeDecodeError) as exc:
             raise ParameterError(f"{option} {str(path)!r}: cannot be read ({exc})") from None
         beside = path.resolve().parent / "package.xml"
-        return cls(path.name, text, kind, package_xml=str(beside) if beside.is_file() else None)
+        return cls(path.name, text, kind, package_xml=str(beside) if beside.is_file() else None,
+                   directory=str(path.resolve().parent))
 
     @classmethod
     def from_dict(cls, data: Any, where: str = "model") -> RobotModel:
@@ -529,7 +532,7 @@ class RobotModel:
 
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "sha256": self.sha256, "format": self.format, "package_xml": self.package_xml,
-                "text": self.text}
+                "directory": self.directory, "text": self.text}
 
 
 @dataclass(frozen=True)

@@ -470,3 +470,46 @@ def test_the_default_contact_is_drakes_default_material_without_the_near_rigid_r
     assert config_of_record(EpisodeConfig(sim=sim).to_dict()).contact == ContactParams()
     legacy = run_episode(config_of_record(old), cache=None)
     assert legacy.cost_of_transport != explicit.cost_of_transport  # the regime changes the contact
+
+
+def test_a_link_fixed_to_the_torso_counts_in_the_torso(tmp_path):
+    """A sensor bolted to the torso (a fixed joint): its mass and centre of mass count in the torso's, the
+    planar kinematics agrees with the plant, and the robot's total is the plant's; a body on a joint of its own
+    is refused by name."""
+    from drake_biped.kinematics import masses_of
+    from drake_biped.model import body_of_model
+    from drake_biped.params import RobotModel
+
+    sensor = ('  <link name="sensor"><inertial><origin xyz="0.05 0 0.2"/><mass value="1.0"/><inertia ixx="0.001" '
+              'ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>\n'
+              '  <joint name="sensor_mount" type="fixed"><parent link="torso"/><child link="sensor"/>'
+              '<origin xyz="0 0 0.1"/></joint>\n</robot>')
+    model = RobotModel.from_file(_model_file(tmp_path, lambda t: t.replace("</robot>", sensor)))
+    masses = masses_of(body_of_model(model))  # ModelError if the kinematics' centre of mass disagreed
+    assert masses.torso == pytest.approx(7.646) and masses.total == pytest.approx(11.202)
+    swinging = sensor.replace('type="fixed"', 'type="revolute"').replace(
+        "<origin xyz=\"0 0 0.1\"/></joint>", '<origin xyz="0 0 0.1"/><axis xyz="0 1 0"/><limit lower="-1" '
+        'upper="1" effort="1" velocity="1"/></joint>')
+    model = RobotModel.from_file(_model_file(tmp_path, lambda t: t.replace("</robot>", swinging), "swing.urdf"))
+    with pytest.raises(ModelError, match="link sensor moves on a joint of its own"):
+        body_of_model(model)
+
+
+def test_a_mesh_named_relative_to_the_model_file_resolves(tmp_path):
+    """A model parsed from its text still finds a mesh named relative to the file it came from."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_biped.params import RobotModel
+
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "box.obj").write_text(
+        "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+    visual = '<visual><geometry><mesh filename="meshes/box.obj"/></geometry></visual>\n  </link>'
+
+    def edit(text):
+        i = text.index("</link>")  # the torso's
+        return text[:i] + visual + text[i + len("</link>"):]
+
+    model = RobotModel.from_file(_model_file(tmp_path, edit))
+    assert model.directory == str(tmp_path.resolve())
+    add_biped(DiagramBuilder(), Ground(), 1e-3, model)  # no ModelError: the relative file name resolved

@@ -169,3 +169,24 @@ def test_the_api_names_a_wrong_argument(tmp_path, monkeypatch, call, match):
     with pytest.raises(ParameterError, match=match):
         call()
     assert not (tmp_path / "never").exists()
+
+
+def test_foreign_records_are_named_not_a_key_error(tmp_path):
+    """A grid's points as a search log, a window map as a time-step study: one ParameterError naming the file
+    and what it is not; a search resumed with another objective is refused naming both."""
+    from drake_biped.experiments import gait_search, time_step
+
+    log = tmp_path / "search.jsonl"
+    log.write_text(json.dumps({"key": "x", "row": {}}) + "\n")
+    settings = gait_search.GaitSearchSettings()
+    with pytest.raises(ParameterError, match=r"search.jsonl, line 1: not a gait-search log \(no 'generation'\)"):
+        gait_search._check_log(gait_search._read_log(log), settings, "es", log)
+    log.write_text(json.dumps({"generation": 0, "parent": {}, "parent_score": 0.1, "objective": "walk",
+                               "sigma": 0.1, "mutations": "default", "seed": 0, "policy_draws": 12}) + "\n")
+    coast = gait_search.GaitSearchSettings(objective="coast", sigma=0.3)
+    with pytest.raises(ParameterError, match=r"begun with other settings \(objective 'walk' there, 'coast' here; "
+                                             r"sigma 0.1 there, 0.3 here\)"):
+        gait_search._check_log(gait_search._read_log(log), coast, "es", log)
+    (tmp_path / "time_step_study.json").write_text(json.dumps({"baseline": {}, "windows": []}))
+    with pytest.raises(ParameterError, match=r"not a time-step study \(no 'steps'\)"):
+        time_step.replot(tmp_path)

@@ -536,6 +536,7 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
     start, seed, sigma = _search_start(settings), settings.seed, settings.sigma
     windows = [tuple(w) for w in settings.windows]
     records = _read_log(log)
+    _check_log(records, settings, "es", log)
     with client_or_local(client) as c:
         if records:
             last = records[-1]
@@ -608,6 +609,7 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
         return es.ask()
 
     records = _read_log(log)
+    _check_log(records, settings, "cmaes", log)
     for r in records[1:]:
         es.tell(ask(r["generation"]), [-v for v in r["child_scores"]])
     with client_or_local(client) as c:
@@ -648,6 +650,28 @@ def _read_log(path: Path) -> list[dict]:
                                      "by a kill is dropped: repair or delete that line to resume") from None
             write_text_atomic(path, "".join(json.dumps(r) + "\n" for r in records))
     return records
+
+
+def _check_log(records: list[dict], settings: GaitSearchSettings, method: str, path: Path) -> None:
+    """ParameterError naming the file unless its records are a search's (each line a generation with its
+    parent and score) made with these settings (the objective, mutations, step, seed and method its first line
+    records): a search is resumed as it began, never continued under another objective."""
+    for i, r in enumerate(records):
+        missing = [k for k in ("generation", "parent", "parent_score") if not isinstance(r, dict) or k not in r]
+        if missing:
+            raise ParameterError(f"{path}, line {i + 1}: not a gait-search log (no {missing[0]!r}); give another "
+                                 "--out")
+    first = records[0] if records else {}
+    if first.get("generation") != 0:
+        return
+    wanted = {"objective": settings.objective, "mutations": settings.mutations, "sigma": settings.sigma,
+              "seed": settings.seed, "policy_draws": settings.policy_draws, "method": method}
+    recorded = {k: first.get(k, "es" if k == "method" else None) for k in wanted}
+    differs = [f"{k} {recorded[k]!r} there, {wanted[k]!r} here" for k in wanted
+               if recorded[k] is not None and recorded[k] != wanted[k]]
+    if differs:
+        raise ParameterError(f"{path} is a search begun with other settings ({'; '.join(differs)}): rerun it with "
+                             "its own settings to resume, or give another --out")
 
 
 def _append(path: Path, record: dict) -> None:

@@ -328,6 +328,9 @@ def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = Tru
 def replot(out: Path) -> dict:
     """Redraw the Markdown and the figure from out/time_step_study.json."""
     rec = read_json(out / "time_step_study.json", "--replot")
+    missing = [k for k in ("steps", "rows", "reference_s") if not isinstance(rec, dict) or k not in rec]
+    if missing:
+        raise ParameterError(f"--replot {out / 'time_step_study.json'}: not a time-step study (no {missing[0]!r})")
     write_text_atomic(out / "time_step_study.md", markdown(rec))
     figure(rec, out / "time_step_study.png")
     return rec
