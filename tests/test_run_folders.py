@@ -190,3 +190,19 @@ def test_foreign_records_are_named_not_a_key_error(tmp_path):
     (tmp_path / "time_step_study.json").write_text(json.dumps({"baseline": {}, "windows": []}))
     with pytest.raises(ParameterError, match=r"not a time-step study \(no 'steps'\)"):
         time_step.replot(tmp_path)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["learn", "--trials", "1000", "--episodes", "1000"], "--trials x --episodes = 1,000,000 episodes"),
+    (["slope", "--slope", "0.02", "--trials", "2000", "--episodes", "100"], "--trials x --episodes = 200,000"),
+    (["stability", "--trials", "20000"], "6 cells x --trials = 120,000 episodes"),
+    (["gait-search", "--generations", "1000", "--offspring", "8"], "--generations x --offspring = 8,000"),
+    (["compare-learners", "--window-map", "m", "--trials", "100", "--episodes", "500"], "learners x --trials x --episodes = 150,000"),
+])
+def test_every_size_a_user_gives_is_bounded_before_any_work(tmp_path, capsys, argv, words):
+    with pytest.raises(SystemExit) as e:
+        main([*argv, "--out", str(tmp_path / "o")])
+    assert e.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and words in err[0] and "--force" in err[0]
+    assert not (tmp_path / "o").exists()
