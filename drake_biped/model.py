@@ -321,9 +321,10 @@ def _check_masses(model: RobotModel) -> None:
         except (TypeError, ValueError):
             raise ModelError(f"the model {model.name}: link {link.get('name')} has mass {text!r}, not a number") \
                 from None
-        if not value > 0.0:
+        if not (value > 0.0 or (value == 0.0 and link.get("name") not in LINKS)):
             raise ModelError(f"the model {model.name}: link {link.get('name')} has mass {value!r} kg; every "
-                             "link's mass must be positive")
+                             "link's mass must be positive (a massless frame-holder, not one of the seven links, "
+                             "may have 0)")
 
 
 def _check_inertia(model: RobotModel, link) -> None:
@@ -389,10 +390,11 @@ def composite(plant: MultibodyPlant, name: str) -> tuple[float, tuple[float, flo
 
 
 def _check_every_body_rides_a_link(plant: MultibodyPlant) -> None:
-    """ModelError naming a body that is neither one of the seven links nor welded to one."""
+    """ModelError naming a body that is neither one of the seven links nor welded to one (or to the world)."""
     if not all(plant.HasBodyNamed(name) for name in LINKS):
         return  # link_masses_of names the missing link
-    riding = {int(b.index()) for name in LINKS for b in plant.GetBodiesWeldedTo(plant.GetBodyByName(name))}
+    riding = {int(b.index()) for name in (*LINKS, plant.world_body().name())
+              for b in plant.GetBodiesWeldedTo(plant.GetBodyByName(name))}  # welded to the world: the ground's
     for index in range(plant.num_bodies()):
         body = plant.get_body(BodyIndex(index))
         if index == int(plant.world_body().index()) or index in riding:

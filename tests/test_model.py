@@ -513,3 +513,24 @@ def test_a_mesh_named_relative_to_the_model_file_resolves(tmp_path):
     model = RobotModel.from_file(_model_file(tmp_path, edit))
     assert model.directory == str(tmp_path.resolve())
     add_biped(DiagramBuilder(), Ground(), 1e-3, model)  # no ModelError: the relative file name resolved
+
+
+def test_an_sdformat_model_of_the_shipped_robot_walks_as_the_urdf(tmp_path):
+    """SDFormat names actuators after their joints and has no planar joint of its own: the shipped robot written
+    as SDFormat (tests/sdf_of_urdf.py) is read to the same body (to rounding: its planar frames are turned by a
+    rotation in floating point) and walks the default gait's 10 m as the URDF does."""
+    from sdf_of_urdf import urdf_to_sdf
+
+    from drake_biped.episode import run_episode
+    from drake_biped.kinematics import TABLE_I_BODY
+    from drake_biped.model import body_of_model
+    from drake_biped.params import EpisodeConfig, RobotModel
+    from drake_biped.resources import shipped_model_file
+
+    path = tmp_path / "biped.sdf"
+    path.write_text(urdf_to_sdf(shipped_model_file().read_text()))
+    model = RobotModel.from_file(path)
+    assert np.max(np.abs(body_of_model(model) - TABLE_I_BODY)) < 1e-12
+    sdf, urdf = run_episode(EpisodeConfig(model=model)), run_episode(EpisodeConfig())
+    assert sdf.termination == urdf.termination == "distance" and len(sdf.steps) == len(urdf.steps)
+    assert sdf.cost_of_transport == pytest.approx(urdf.cost_of_transport, rel=2e-3)
