@@ -206,3 +206,23 @@ def test_every_size_a_user_gives_is_bounded_before_any_work(tmp_path, capsys, ar
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and words in err[0] and "--force" in err[0]
     assert not (tmp_path / "o").exists()
+
+
+def test_a_cluster_that_loses_every_worker_is_said_within_seconds(monkeypatch):
+    """A run waiting on a scheduler whose only worker leaves for good stops within seconds with a ClusterLost
+    naming the scheduler, instead of waiting without a word."""
+    import time
+
+    from distributed import LocalCluster
+
+    from drake_biped.experiments import executor
+
+    monkeypatch.setattr(executor, "WORKER_WAIT_S", 1.0)
+    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:
+        start = time.monotonic()
+        with pytest.raises(executor.ClusterLost, match=r"--scheduler .*: every worker left the cluster"):
+            with executor.dask_client(scheduler=cluster.scheduler_address) as client:
+                future = client.submit(time.sleep, 60, pure=False)
+                cluster.scale(0)
+                future.result()
+        assert time.monotonic() - start < 30

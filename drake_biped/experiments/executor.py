@@ -94,9 +94,15 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, force:
             client.close()
             raise ParameterError(f"--scheduler {scheduler}: the scheduler answers but has no workers (none joined "
                                  f"within {WORKER_WAIT_S:g} s); start one: dask worker {scheduler}") from None
+        watch = WorkerWatch(client, scheduler)
         try:
             yield client
+        except BaseException as exc:
+            if watch.lost is not None and not isinstance(exc, (KeyboardInterrupt, SystemExit)):
+                raise ClusterLost(watch.lost) from exc  # its tasks were cancelled: the workers were gone
+            raise
         finally:
+            watch.stop()
             client.close()
         return
     n = workers or max(1, os.cpu_count() or 1)
@@ -108,6 +114,48 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, force:
     finally:
         client.close()
         cluster.close()
+
+
+class ClusterLost(RuntimeError):
+    """The cluster had no worker for WORKER_WAIT_S while a run waited on it: the run stops and says so."""
+
+
+class WorkerWatch:
+    """Watches a scheduler's workers from a thread while a run uses it: when none is left for WORKER_WAIT_S,
+    the client's pending tasks are cancelled (the run waiting on them stops at once) and `lost` says why."""
+
+    def __init__(self, client: Any, scheduler: str, poll_s: float = 1.0):
+        self.client, self.scheduler, self.poll_s = client, scheduler, poll_s
+        self.lost: str | None = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="drake-biped-worker-watch", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        import time
+
+        since = None
+        while not self._stop.wait(self.poll_s):
+            try:
+                n = len(self.client.scheduler_info().get("workers", {}))
+            except Exception:  # the client is closing
+                return
+            if n > 0:
+                since = None
+                continue
+            since = since or time.monotonic()
+            if time.monotonic() - since >= WORKER_WAIT_S and self.client.futures:
+                self.lost = (f"--scheduler {self.scheduler}: every worker left the cluster and none came back within "
+                             f"{WORKER_WAIT_S:g} s; start one (dask worker {self.scheduler}) and rerun the command "
+                             "to resume")
+                from distributed import Future
+
+                self.client.cancel([Future(key, self.client) for key in list(self.client.futures)])
+                return
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5.0)
 
 
 @contextmanager
