@@ -646,11 +646,12 @@ def resolve_field(name: str) -> tuple[str, str]:
                              f"{list(_SECTIONS)}, or one of {sorted(SHORT_NAMES)}")
     return section, attr
 
-# The gait this toolkit walks by default (README, "Model and controller choices"; docs/RESULTS.md, "One gait"):
-# found by `gait-search --objective hold` (benchmarks/results/learn-hold-g1/gait.json, which starts from 0.1326
-# rad, this from the paper's 7.6 deg). Windows from 0.30 to 0.46 s after touchdown save 43-52 % when re-walked at
-# half the plant step and from 0.95 / 1.05 x the initiation speed. The walking region is narrow: keep the values
-# together, at full precision. The previous default is the shipped gait "steady" (--params steady).
+# The gait this toolkit walks by default (README, "Model and controller choices"; docs/RESULTS.md, "One gait" and
+# "Physics with a continuous limit"): found by `gait-search --objective hold` (benchmarks/results/learn-hold-g1/
+# gait.json, which starts from 0.1326 rad, this from the paper's 7.6 deg). A window from t1 until touchdown saves
+# while t1 lies inside the powered step; past its end (t1 from about 0.43 s) it acts only on steps that run long.
+# The walking region is narrow: keep the values together, at full precision. The previous default is the shipped
+# gait "steady" (--params steady).
 DEFAULT_CPG = CpgParams(alpha=1.0, u_a=2.3755367036013615, u_eta=0.0, u_r=9.164202559982812, kappa=4.300448011279704)
 DEFAULT_GAIT = GaitParams(
     hip_kp=203.6745553930685,
