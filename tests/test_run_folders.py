@@ -226,3 +226,29 @@ def test_a_cluster_that_loses_every_worker_is_said_within_seconds(monkeypatch):
                 cluster.scale(0)
                 future.result()
         assert time.monotonic() - start < 30
+
+
+@pytest.mark.parametrize("epsilon, words", [
+    (None, "no perturbation converged: not established: the Jacobian did not converge"),
+    (1e-4, "converged at epsilon 0.0001"),
+])
+def test_floquet_says_on_the_console_whether_its_orbit_is_established(tmp_path, capsys, monkeypatch, epsilon, words):
+    from drake_biped.experiments import floquet
+
+    record = {"spectral_radius": 13.441, "fixed_point_residual": 1e-9, "converged_epsilon": epsilon,
+              "evaluation_noise": None, "settings": {"newton_tolerance": 1e-6}}
+    monkeypatch.setattr(floquet, "run", lambda settings, out, client: record)
+    assert main(["floquet", "--workers", "1", "--out", str(tmp_path / "f")]) == 0
+    out = capsys.readouterr().out
+    assert "spectral radius 13.4410" in out and words in out and "epsilon None" not in out
+
+
+def test_the_command_line_runs_its_bars_without_tqdms_monitor_thread(tmp_path):
+    """tqdm's monitor thread, stopped at exit, printed its own traceback when a second Ctrl-C came while the
+    process exited: the command line turns it off."""
+    from tqdm import tqdm
+
+    tqdm.monitor_interval = 10
+    with pytest.raises(SystemExit):
+        main(["walk", "--t1", "0.5", "--out", str(tmp_path / "w")])  # refused: --t1 without --t2
+    assert tqdm.monitor_interval == 0
