@@ -161,28 +161,6 @@ CLAIM_KEYS = ("table_iii", "paper_gait", "grid", "learn", "learn_variant", "comp
 # The learning runs whose evaluated windows a quick run re-walks (DIR/<source>/learning.json).
 CHECKED_SOURCES = {"learn": ("learn",), "learn_variant": ("learn_variant",)}
 # The shipped gaits other than the default, and why each exists (the report's closing section).
-OTHER_GAITS = {
-    "paper": "Table III and the paper's initiation as printed, the unprinted gains searched (1 430 candidates), "
-             "under the integrated reading: falls after two steps",
-    "paper_entrained": "Table III and the paper's initiation under the entrained phase reading (the CPG runs "
-                       "free, ζ's sign picks the swing): walks 10 m (C_mt 0.175) but falls from 0.95 or 1.05 × the "
-                       "initiation speed and to ±20 N pushes",
-    "climbing": "the 0.02 rad grid's best from `steady` (torso leaned forward, larger placement gain): "
-                "climbs 0.02 rad without a window",
-    "climbing_2deg": "the 2.0° grid's best from `climbing` (u_a raised, torso leaned further): climbs 2.0°",
-    "attracting": "searched for a period-1 orbit that attracts (Floquet ρ 0.08): slower and less push-robust "
-                  "than `steady`",
-    "coasting": "searched so that its swing coasts to touchdown (hip off from 0.3 or 0.4 s walks 10 m)",
-    "coasting_garb": "searched from `coasting` for the paper's start policy, whose expected reward at (0.5, 0.5) "
-                     "beats no window; Table VI fails with its learned window",
-    "coasting_wide": "searched from `coasting_garb` by that expected reward: GARB with the paper's settings saves "
-                     "48.8 % at 0.5 ms, but three of its five windows start past the end of its powered step and "
-                     "save 14–39 % at 0.25 ms",
-    "steady": "the first default: walks from the paper's initiation at C_mt 0.219 and through 75 / 47 N pushes, "
-              "but GARB with the paper's settings learns no window on it (0 of 5) and its orbit is a saddle",
-}
-
-
 def _steps(n: int) -> str:
     return f"{n} step" if n == 1 else f"{n} steps"
 
@@ -425,13 +403,14 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
 
 def other_gaits_section() -> list[str]:
     """The report's closing section: the shipped gaits other than the default, and why each exists."""
-    from drake_biped.resources import gait_names
+    from drake_biped.resources import gait_about, gait_names
 
     lines = ["## Other gaits, and why each exists", "",
              "Every claim above is measured on the default gait. The other shipped gaits (`--params NAME`) each "
-             "told part of the story before it; their records are in docs/RESULTS.md.", "",
+             "told part of the story before it; their records are in docs/RESULTS.md. Each one's reasons are its "
+             "file's `about` (drake_biped/gaits/).", "",
              "| gait | why it exists |", "|---|---|"]
-    lines += [f"| `{name}` | {OTHER_GAITS.get(name, '—')} |" for name in gait_names()]
+    lines += [f"| `{name}` | {gait_about(name)} |" for name in gait_names() if name != "default"]
     return lines + [""]
 
 
@@ -596,7 +575,7 @@ def full_run_gait(full_run: dict[str, Any] | None) -> str | None:
     same = lambda a, b: all(a.get(k) == b.get(k) for k in sections)  # noqa: E731
     if same(configs[0], EpisodeConfig().to_dict()):
         return None
-    for name in gait_names():
+    for name in (n for n in gait_names() if n != "default"):
         if same(configs[0], load_gait(name).to_dict()):
             return f"`{name}`"
     return "another gait"

@@ -652,31 +652,18 @@ def resolve_field(name: str) -> tuple[str, str]:
 # while t1 lies inside the powered step; past its end (t1 from about 0.43 s) it acts only on steps that run long.
 # The walking region is narrow: keep the values together, at full precision. The previous default is the shipped
 # gait "steady" (--params steady).
-DEFAULT_CPG = CpgParams(alpha=1.0, u_a=2.3755367036013615, u_eta=0.0, u_r=9.164202559982812, kappa=4.300448011279704)
-DEFAULT_GAIT = GaitParams(
-    hip_kp=203.6745553930685,
-    hip_kd=10.703999601430631,
-    hip_ki=0.0,
-    placement_gain=0.3320493249583393,
-    placement_velocity_gain=0.16072233169372896,
-    torso_kp=312.7599763908924,
-    torso_kd=17.642142281943457,
-    torso_pitch_rad=-0.4369726563835759,
-    knee_flex_torque=5.300991480352644,
-    knee_extend_torque=14.804771892511479,
-    knee_extend_phase=3.1,
-    knee_flex_max_rad=0.42621219173395786,
-    knee_extend_thigh_rad=0.35881932564612357,
-    knee_flex_until_phase=0.22409554329294284,
-    knee_hold_torque=-0.2817644964158232,
-    stance_knee_torque=24.224101821366588,
-    ankle_kp=20.0,
-    ankle_kd=0.3,
-    touchdown_min_step_s=0.15,
-    touchdown_height_m=0.002,
-    touchdown_min_advance_m=0.05,
-    touchdown_min_phase=2.5357676480810656,
-)
+def _shipped_default() -> tuple[CpgParams, GaitParams]:
+    """The default gait's CPG and gains, from the shipped gait file drake_biped/gaits/default.json (its `about`
+    says why it exists and where it came from)."""
+    import json
+    from importlib import resources
+
+    data = json.loads(resources.files("drake_biped").joinpath("gaits", "default.json").read_text())
+    where = "drake_biped/gaits/default.json"
+    return CpgParams.from_dict(data["cpg"], f"{where}, cpg"), GaitParams.from_dict(data["gait"], f"{where}, gait")
+
+
+DEFAULT_CPG, DEFAULT_GAIT = _shipped_default()
 # A second initiation for the gait "steady" (--params steady), closer to its limit cycle: every acceptance window
 # walks 10 m from it.
 CYCLE_INITIAL = InitialConditions(hip_angle_rad=0.5027, speed_mps=0.5977)

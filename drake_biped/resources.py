@@ -14,7 +14,7 @@ from pathlib import Path
 
 from drake_biped.params import EpisodeConfig, ParameterError
 
-__all__ = ["full_run_digest", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
+__all__ = ["full_run_digest", "gait_about", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
            "shipped_model_file"]
 
 
@@ -65,6 +65,13 @@ def _named_or_path(value: str | Path, folder: str, suffix: str, names: list[str]
     raise ParameterError(f"{what} {text!r}: neither a file nor a shipped name (one of {names})")
 
 
+def gait_about(name: str) -> str:
+    """Why the shipped gait `name` exists, where it came from and the claim it carries: its file's `about`."""
+    import json
+
+    return str(json.loads(gait_path(name).read_text()).get("about", ""))
+
+
 def gait_path(value: str | Path) -> Path:
     """A shipped gait by name (`climbing`, `climbing_2deg`, ...) or a parameter file by path."""
     return _named_or_path(value, "gaits", ".json", gait_names(), "--params")
@@ -85,6 +92,8 @@ def load_gait(value: str | Path) -> EpisodeConfig:
     data = read_json(path, "--params")
     if isinstance(data, dict) and "config" in data:
         data = data["config"]
+    if isinstance(data, dict):
+        data = {k: v for k, v in data.items() if k != "about"}  # a gait file's reasons, not a parameter
     if isinstance(data, dict) and isinstance(data.get("model"), str):
         # a model file named in a parameter file: a relative path is relative to the parameter file
         data = {**data, "model": str(Path(path).parent / data["model"])}

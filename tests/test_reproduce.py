@@ -247,13 +247,23 @@ def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_nu
     assert "| this run (quick) | full run (checked here) |" in text and "not run at this size" in text
 
 
-def test_every_other_shipped_gait_says_why_it_exists():
-    from drake_biped.analysis.reproduce_report import OTHER_GAITS, other_gaits_section
-    from drake_biped.resources import gait_names
+def test_every_shipped_gait_says_why_it_exists_and_the_report_reads_it_from_the_file():
+    """Every gait file has an `about` with why, where from and its claim; the report's closing section lists
+    the gaits other than the default with their files' reasons; gaits/default.json is EpisodeConfig()."""
+    import json
 
-    assert set(OTHER_GAITS) == set(gait_names())
+    from drake_biped.analysis.reproduce_report import other_gaits_section
+    from drake_biped.params import EpisodeConfig
+    from drake_biped.resources import gait_about, gait_names, gait_path, load_gait
+
+    assert "default" in gait_names()
+    for name in gait_names():
+        about = json.loads(gait_path(name).read_text())["about"]
+        assert about == gait_about(name) and all(w in about for w in ("Why:", "Source:", "Claim:")), name
     section = "\n".join(other_gaits_section())
-    assert all(f"| `{name}` | {OTHER_GAITS[name]} |" in section for name in gait_names())
+    assert all(f"| `{name}` | {gait_about(name)} |" in section for name in gait_names() if name != "default")
+    assert "| `default` |" not in section
+    assert load_gait("default") == EpisodeConfig()
 
 
 def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp_path):
