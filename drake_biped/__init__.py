@@ -24,7 +24,13 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
+try:  # the installed distribution's version (pyproject.toml): typed in one place
+    from importlib.metadata import PackageNotFoundError as _NotFound
+    from importlib.metadata import version as _version
+
+    __version__ = _version("drake-biped")
+except _NotFound:  # run from a source tree that was never installed
+    __version__ = "0+unknown"
 
 # name -> module that defines it
 _API = {
