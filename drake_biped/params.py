@@ -646,7 +646,7 @@ def resolve_field(name: str) -> tuple[str, str]:
                              f"{list(_SECTIONS)}, or one of {sorted(SHORT_NAMES)}")
     return section, attr
 
-# The gait this toolkit walks by default (README, "Model and controller choices"; docs/RESULTS.md, "One gait" and
+# The gait this toolkit walks by default (docs/MODEL.md, "Model and controller choices"; docs/RESULTS.md, "One gait" and
 # "Physics with a continuous limit"): found by `gait-search --objective hold` (benchmarks/results/learn-hold-g1/
 # gait.json, which starts from 0.1326 rad, this from the paper's 7.6 deg). A window from t1 until touchdown saves
 # while t1 lies inside the powered step; past its end (t1 from about 0.43 s) it acts only on steps that run long.

@@ -4,7 +4,7 @@ A (1 + lambda) evolution strategy: each generation mutates the parent `offspring
 for positive gains, Gaussian steps for angles and phases), scores every child, and keeps the best child
 if it scores at least as well as the parent (`--method cmaes`: CMA-ES over the same mutations). This is how
 the shipped gaits were found: "steady" (the first default) from a walker of an earlier random search, and
-`params.DEFAULT_CPG`/`DEFAULT_GAIT` by the "hold" objective (see README).
+`params.DEFAULT_CPG`/`DEFAULT_GAIT` by the "hold" objective (docs/MODEL.md).
 
 Score of a configuration that does not walk `distance_m` without a window: -9 + 8 * (the fraction of the
 distance it walked), so that a search from a gait that falls climbs towards one that walks. Of one that
