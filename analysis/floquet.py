@@ -290,3 +290,103 @@ def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) ->
         d = jacobian @ d
         out.append(d)
     return np.array(out)
+
+
+MAX_PERIOD = 8
+
+
+class NoPeriodicOrbit(RuntimeError):
+    """The iterates of a map repeat with no period up to the largest looked for: an irregular attractor (or a
+    transient longer than the iterations given). `iterates` holds the last ones."""
+
+    def __init__(self, message: str, iterates: np.ndarray):
+        super().__init__(message)
+        self.iterates = iterates
+
+
+@dataclass(frozen=True)
+class PeriodicOrbit:
+    """An orbit of period `period` of a map P: `points` (period x n), points[i + 1] = P(points[i]) and
+    P(points[-1]) = points[0]; `multipliers`, the eigenvalues of the k-fold map's Jacobian at points[0]
+    (largest modulus first; the same at every point of the orbit); `jacobian` that Jacobian; `residual`
+    |P^k(x) - x| / |x| at the orbit; `detected`, the period the iterates showed (None when `period` was given)."""
+
+    period: int
+    points: np.ndarray
+    multipliers: np.ndarray
+    jacobian: np.ndarray
+    residual: float
+    converged: bool
+    detected: int | None
+
+    @property
+    def spectral_radius(self) -> float:
+        return float(np.max(np.abs(self.multipliers)))
+
+    @property
+    def attracting(self) -> bool:
+        return self.spectral_radius < 1.0
+
+
+def repeat_period(iterates: np.ndarray, max_period: int = MAX_PERIOD, tolerance: float = 1e-6) -> int | None:
+    """The smallest k <= max_period with |x_j - x_(j-k)| <= tolerance (|x_j| + 1) over the last 2 max_period
+    iterates (rows of `iterates`), or None."""
+    x = np.asarray(iterates, dtype=float)
+    window = 2 * max_period
+    if x.ndim != 2 or len(x) < window + max_period:
+        raise ValueError(f"repeat_period: need at least {window + max_period} iterates (rows), got {x.shape}")
+    tail = x[-(window + max_period):]
+    for k in range(1, max_period + 1):
+        a, b = tail[k:], tail[:-k]
+        a, b = a[-window:], b[-window:]
+        if np.all(np.linalg.norm(a - b, axis=1) <= tolerance * (np.linalg.norm(a, axis=1) + 1.0)):
+            return k
+    return None
+
+
+def periodic_orbit(step: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, period: int | None = None,
+                   max_period: int = MAX_PERIOD, transient: int = 500, detect_tolerance: float = 1e-6,
+                   epsilon: float | Sequence[float] = 1e-6, tolerance: float = 1e-10,
+                   max_iterations: int = 8) -> PeriodicOrbit:
+    """The attracting orbit of the smallest period k <= max_period of the map `step` (a 1-D array to a 1-D
+    array) that the iterates from x0 settle on: iterate `transient` times, find the smallest k with which the
+    last iterates repeat (`repeat_period`), then Newton on P^k(x) = x from the last iterate (central-difference
+    Jacobians of the k-fold map, `epsilon` per coordinate) for the orbit, its points and the multipliers of
+    the k-fold map. `period`: skip the detection and look for an orbit of that period (also a repelling one,
+    from a start near it). NoPeriodicOrbit when the iterates show no period up to max_period; StepFailed
+    when a step fails."""
+    x = np.asarray(x0, dtype=float).reshape(-1)
+    dim = len(x)
+
+    def one(state: np.ndarray) -> np.ndarray:
+        (y,) = check_outputs([step(np.asarray(state, dtype=float))], [state], dim)
+        return y
+
+    detected = None
+    if period is None:
+        iterates = [x]
+        for _ in range(max(transient, 3 * max_period)):
+            iterates.append(one(iterates[-1]))
+        iterates = np.array(iterates)
+        detected = repeat_period(iterates, max_period, detect_tolerance)
+        if detected is None:
+            raise NoPeriodicOrbit(f"the iterates show no period up to {max_period} after {len(iterates) - 1} steps "
+                                  "(an irregular attractor, or a longer transient)", iterates[-4 * max_period:])
+        period, x = detected, iterates[-1]
+    elif not isinstance(period, (int, np.integer)) or period < 1:
+        raise ValueError(f"periodic_orbit: period must be an integer >= 1, got {period!r}")
+
+    def k_fold(state: np.ndarray) -> np.ndarray:
+        for _ in range(period):
+            state = one(state)
+        return state
+
+    fixed = newton_fixed_point(serial(k_fold), x, epsilon, tolerance=tolerance, max_iterations=max_iterations)
+    start = fixed.state
+    jac = difference_jacobian(serial(k_fold), start, epsilon)
+    points = [start]
+    for _ in range(period - 1):
+        points.append(one(points[-1]))
+    values = multipliers(jac).values
+    return PeriodicOrbit(period=int(period), points=np.array(points), multipliers=values, jacobian=jac,
+                         residual=fixed.residual, converged=fixed.converged, detected=detected)
