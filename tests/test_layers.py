@@ -14,6 +14,7 @@ LAYERS = {
     "drake_biped.analysis.return_map": PURE,
     "drake_biped.analysis.series": PURE,
     "drake_biped.analysis.long_run": PURE,
+    "drake_biped.analysis.attractor": PURE,
     "drake_biped.analysis.landscape": PURE,
     "drake_biped.analysis.learner_comparison": PURE,
     "drake_biped.analysis.floquet": PURE,
