@@ -6,7 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from drake_biped.analysis.attractor import lyapunov_from_jacobians, lyapunov_from_neighbours, step_period_label
+from drake_biped.analysis.attractor import (
+    lyapunov_from_jacobians,
+    lyapunov_from_neighbours,
+    step_period_label,
+)
 
 
 @pytest.mark.parametrize("pattern, expected", [
