@@ -62,7 +62,7 @@ def test_nearby_orbits_of_the_henon_map_part_at_its_exponent():
     for _ in range(1000):
         x = henon(x)
     estimates = []
-    for k in range(20):
+    for _ in range(20):
         a, b = [x], [x + np.array([1e-9, 0.0])]
         for _ in range(40):
             a.append(henon(a[-1]))
