@@ -112,6 +112,8 @@ class _Validated:
             raise ParameterError(f"{where}: expected a mapping of {cls.__name__} fields, got {type(data).__name__} "
                                  f"{shown}")
         data = dict(data)
+        if cls is EpisodeConfig:
+            data.pop("about", None)  # a shipped gait file's reasons (drake_biped/gaits/): text, not a parameter
         known = {f.name: f for f in fields(cls)}
         unknown = sorted(set(data) - set(known))
         if unknown:
