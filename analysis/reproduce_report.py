@@ -281,7 +281,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         f"The shipped gait `paper`: Table III's CPG ({', '.join(f'{k} {v:g}' for k, v in pg['cpg'].items())}) and the "
         f"paper's initiation, ζ driving the swing unscaled (the integrated reading), the gains the paper does not "
-        f"print from a search of 1 430 candidates (docs/RESULTS.md): "
+        f"print from a search of 1 430 candidates (docs/HISTORY.md): "
         + ("walks 10 m" if not pg["fell"] else f"falls after {_steps(pg['steps'])} ({pg['fall_reason']}), "
                                               f"{pg['distance_m']:.2f} m")
         + ". Record: [result.json](paper_gait/result.json).",
@@ -407,7 +407,7 @@ def other_gaits_section() -> list[str]:
 
     lines = ["## Other gaits, and why each exists", "",
              "Every claim above is measured on the default gait. The other shipped gaits (`--params NAME`) each "
-             "told part of the story before it; their records are in docs/RESULTS.md. Each one's reasons are its "
+             "told part of the story before it; their records are in docs/HISTORY.md. Each one's reasons are its "
              "file's `about` (drake_biped/gaits/).", "",
              "| gait | why it exists |", "|---|---|"]
     lines += [f"| `{name}` | {gait_about(name)} |" for name in gait_names() if name != "default"]

@@ -146,7 +146,7 @@ def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
     config = _with_model(config.override(changes), args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
         print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
-              "steps at which the default gait's walk converges (docs/RESULTS.md, 'Time step'); from 5 ms its "
+              "steps at which the default gait's walk converges (docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its "
               "control loop diverges, which ends an episode as 'diverged'", file=sys.stderr)
     return config if args.seed is None else config.replace(seed=args.seed)
 

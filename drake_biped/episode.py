@@ -303,7 +303,7 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     fall at the same time (the controller reads the plant's sampled output: the state the step makes; the
     step acts with the torques held before). The same numbers as the Simulator path to the last bit
     (tests/test_hot_path.py), without the Simulator's event dispatch and the Python callback it makes every
-    control period: the default walk at 0.91 of the plant's speed instead of 0.73 (docs/RESULTS.md, "The
+    control period: the default walk at 0.91 of the plant's speed instead of 0.73 (docs/HISTORY.md, "The
     plant stepped directly")."""
     plant, controller = parts.plant, parts.controller
     plant_ctx = plant.GetMyMutableContextFromRoot(root)

@@ -439,7 +439,7 @@ class ContactParams(_Validated):
 
     `sap_near_rigid_threshold` 0 turns off SAP's near-rigid regime. At Drake's default (1.0) SAP regularises
     a contact it judges too stiff for the step by an amount that depends on the step: the contact changes when
-    the step is halved and long walks do not converge (docs/RESULTS.md, "Time step"). A field left None takes
+    the step is halved and long walks do not converge (docs/RESULTS.md, "Physics with a continuous limit"). A field left None takes
     Drake's default."""
 
     stiffness_npm: float | None = 1e6
@@ -648,7 +648,7 @@ def resolve_field(name: str) -> tuple[str, str]:
                              f"{list(_SECTIONS)}, or one of {sorted(SHORT_NAMES)}")
     return section, attr
 
-# The gait this toolkit walks by default (docs/MODEL.md, "Model and controller choices"; docs/RESULTS.md, "One gait" and
+# The gait this toolkit walks by default (docs/MODEL.md, "Model and controller choices"; docs/HISTORY.md, "One gait"; docs/RESULTS.md,
 # "Physics with a continuous limit"): found by `gait-search --objective hold` (benchmarks/results/learn-hold-g1/
 # gait.json, which starts from 0.1326 rad, this from the paper's 7.6 deg). A window from t1 until touchdown saves
 # while t1 lies inside the powered step; past its end (t1 from about 0.43 s) it acts only on steps that run long.
