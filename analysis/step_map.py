@@ -197,11 +197,11 @@ class SectionMap:
         root = self._simulator.get_mutable_context()
         self._parts.diagram.SetDefaultContext(root)
         root.SetTime(snap.time_s)
-        self._parts.controller.configure(self.config)
         plant_ctx = self._parts.plant.GetMyMutableContextFromRoot(root)
         self._parts.plant.SetPositionsAndVelocities(plant_ctx, snap.plant)
         ctrl = self._parts.controller
         ctrl_ctx = ctrl.GetMyMutableContextFromRoot(root)
+        ctrl.set_episode(ctrl_ctx, self.config)
         ctrl_ctx.get_mutable_discrete_state(ctrl.torque_group).SetFromVector(snap.torques)
         ctrl_ctx.get_mutable_discrete_state(ctrl.state_group).SetFromVector(snap.controller)
 

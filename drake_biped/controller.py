@@ -34,8 +34,8 @@ each holds (GaitParams.swap_timing "predicted"; "update" swaps them at the updat
 tests/test_hot_path.py and tests/test_gait.py pin this down.
 
 The update's arithmetic is one compiled kernel (`control_step`, numba): Python only hands it the plant state,
-the update's own state vector (written in place) and the episode's numbers packed once per episode (`LAW`,
-`law_vector`), and turns its return code into the touchdown row and the EventStatus. An episode that records
+the update's own state vector (written in place) and the episode's numbers, a numeric parameter of the
+context packed once per episode (`LAW`, `law_vector`, `set_episode`), and turns its return code into the touchdown row and the EventStatus. An episode that records
 nothing calls the kernel itself between the plant's steps, on this system's state in the same context
 (episode._step_directly), with the same numbers.
 """
@@ -162,8 +162,8 @@ def touchdown_capacity(config: EpisodeConfig) -> int:
 
 
 
-# The episode's numbers as the compiled update takes them: one vector, packed by law_vector() when the
-# controller is configured (per episode), read in the kernel through the constants below.
+# The episode's numbers as the compiled update takes them: one vector, packed by law_vector() into the context's
+# numeric parameter when an episode is set (`set_episode`), read in the kernel through the constants below.
 LAW = VectorLayout("law", (
     Field("control_period_s", 1, "dt"),
     Field("state_lag_s", 1, "the plant step: the state read at update time t is the state at t + lag"),
@@ -549,7 +549,10 @@ class CpgWalkingController(LeafSystem):
         # Structure: fixed for the life of the system.
         self._structure = self.structure_key(config)
         self._capacity = touchdown_capacity(config)
-        self.configure(config)
+        # The episode's numbers (CPG, gait, window, fall thresholds: LAW) are a parameter of the Context, as
+        # Drake's systems carry theirs: one built diagram serves any episode of its structure through its
+        # context (`set_episode`), and nothing of the system changes between runs.
+        self._law_index = self.DeclareNumericParameter(BasicVector(law_vector(config)))
 
         self._plant_state = self.DeclareVectorInputPort("plant_state", 18)
         initial = np.zeros(N_STATE)
@@ -573,14 +576,18 @@ class CpgWalkingController(LeafSystem):
         sim = config.sim
         return (config.ground, sim.time_step_s, sim.control_period_s, sim.max_time_s, config.gait.touchdown_min_step_s)
 
-    def configure(self, config: EpisodeConfig) -> None:
-        """Take the per-episode numbers (CPG, gait, window, fall thresholds) of `config` for the next
-        simulation. Its structure (ground, time step, control period, touchdown capacity) must be the one
-        this system was built with. Call it between simulations, never during one."""
+    def set_episode(self, context, config: EpisodeConfig) -> None:
+        """Put the per-episode numbers (CPG, gait, window, fall thresholds) of `config` into this system's
+        `context` (its LAW parameter). Its structure (ground, time step, control period, touchdown capacity)
+        must be the one this system was built with."""
         if self.structure_key(config) != self._structure:
-            raise ValueError("configure: this controller was built for another ground, time step, control "
+            raise ValueError("set_episode: this controller was built for another ground, time step, control "
                              "period, time limit or minimum step time; build a new diagram")
-        self._law = law_vector(config)
+        context.get_mutable_numeric_parameter(self._law_index).SetFromVector(law_vector(config))
+
+    def law(self, context) -> np.ndarray:
+        """The LAW vector in `context` (a view of the context's parameter)."""
+        return context.get_numeric_parameter(self._law_index).get_value()
 
     def get_input_port_plant_state(self):
         """The plant state q (9), v (9) this controller reads."""
@@ -603,11 +610,11 @@ class CpgWalkingController(LeafSystem):
         """The discrete group of the recorded touchdowns (capacity x TOUCHDOWN rows)."""
         return int(self._touchdown_group)
 
-    def kernel_arguments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def kernel_arguments(self, context) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What `control_step` takes besides the time, the plant state and the state vectors, for a caller
         that steps the plant itself (episode._step_directly): the episode's law vector, the body and the
         touchdown row it fills."""
-        return self._law, self._body, self._row
+        return self.law(context), self._body, self._row
 
     def store_touchdown(self, touchdowns: np.ndarray) -> None:
         """Write the touchdown row the kernel just filled (it returned TOUCHED) into the touchdown group's
@@ -661,7 +668,7 @@ class CpgWalkingController(LeafSystem):
     def _update(self, context, discrete_state):
         # The discrete state handed to the update holds the current values; the kernel advances the
         # controller state and the held torques in place.
-        code = control_step(self._law, self._body, context.get_time(), self._plant_state.Eval(context),
+        code = control_step(self.law(context), self._body, context.get_time(), self._plant_state.Eval(context),
                             discrete_state.get_mutable_value(self._state_group),
                             discrete_state.get_mutable_value(self._torque_group), self._row)
         if code == 0:

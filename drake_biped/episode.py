@@ -189,21 +189,21 @@ class Kick:
 
 def reset_context(parts: BipedDiagram, simulator: Simulator, config: EpisodeConfig):
     """Put the simulator's context at the start of an episode of `config`: defaults, time 0, empty logs,
-    the controller configured, the paper's initiation. Returns the plant's and the controller's contexts
-    and the initial centre-of-mass x."""
+    the episode's numbers in the controller's context, the paper's initiation. Returns the plant's and the
+    controller's contexts and the initial centre-of-mass x."""
     root = simulator.get_mutable_context()
     parts.diagram.SetDefaultContext(root)
     root.SetTime(0.0)
     for log in (parts.state_log, parts.controller_log, parts.actuation_log):
         if log is not None:
             log.FindMutableLog(root).Clear()
-    parts.controller.configure(config)
     plant_ctx = parts.plant.GetMyMutableContextFromRoot(root)
     q0, v0, stance_right, liftoff = initial_state(config, parts.body)
     parts.plant.SetPositions(plant_ctx, q0)
     parts.plant.SetVelocities(plant_ctx, v0)
     com_x0 = center_of_mass(q0, parts.body)[0]
     ctrl_ctx = parts.controller.GetMyMutableContextFromRoot(root)
+    parts.controller.set_episode(ctrl_ctx, config)
     parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
                                       pitch=q0[2], phase=config.initial.cpg_phase_rad)
     return plant_ctx, ctrl_ctx, com_x0
@@ -314,7 +314,7 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     s = ctrl_ctx.get_mutable_discrete_state(controller.state_group).get_mutable_value()
     tau = ctrl_ctx.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
     touchdowns = ctrl_ctx.get_mutable_discrete_state(controller.touchdown_group).get_mutable_value()
-    law, body, row = controller.kernel_arguments()
+    law, body, row = controller.kernel_arguments(ctrl_ctx)
     store = controller.store_touchdown
     torques = controller.torque_group
     step = plant.ExecuteForcedEvents
