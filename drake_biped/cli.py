@@ -632,7 +632,8 @@ def build_parser() -> argparse.ArgumentParser:
     wmap.add_argument("--out", required=True, type=_out_folder, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
 
-    search = sub.add_parser("gait-search", help="evolve gait parameters for walking and torque-free savings")
+    search = sub.add_parser("gait-search", help="evolve gait parameters for walking and torque-free savings",
+                            epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
     _add_episode_options(search)
     search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
     search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
@@ -645,25 +646,8 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--method", choices=["es", "cmaes"], default="es",
                         help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                              "offspring candidates a generation")
-    search.add_argument("--objective", default="windows",
-                        choices=list(OBJECTIVES),
-                        help="score of a walker: 'windows' (the best acceptance window's saving), 'walk' (none: "
-                             "find a walker), 'policy' (the expected reward of the paper's start policy, plus "
-                             "half its best draw's), 'expected' (that expected reward alone), "
-                             "'nearest' (the CPG's nearness to Table III, and surviving +-20 N pushes), 'coast' (hip off from t1 until "
-                             "touchdown), 'floquet' ((1 - rho)/(1 + rho) of the period-1 orbit), 'landscape' "
-                             "(the paper's start policy's expected gain on a coarse window map, half the best "
-                             "mean's up to 0.2, less 0.25 a failed 20 N push), 'robust' (how far the walk is from "
-                             "holding at half the plant step, from 0.95 and 1.05 x the initiation speed and under "
-                             "+-20 N pushes; 0 once all hold), 'story' ('robust' first, then 'policy' with each "
-                             "draw judged at the step and half the step and the best draw from 0.95 and 1.05 x "
-                             "the initiation speed), 'hold' ('robust' first, then the smallest C_mt saving, over the "
-                             "walk as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, "
-                             "of every hip-off-until-touchdown window t1 0.30-0.56 s within the learner's reach (the "
-                             "best reward's plateau, and 0.36-0.48 s where GARB's means have ended) and 0.02 s "
-                             "around it), 'hold-long' ('robust' first, then the smallest long-run C_mt saving of "
-                             "t1 0.36, 0.40, 0.44, 0.48 s until touchdown over 40 m walks, as they are, at half the "
-                             "step and from 0.95 and 1.05 x the initiation speed)")
+    search.add_argument("--objective", default="windows", choices=list(OBJECTIVES),
+                        help="what a walker scores (each objective's definition below)")
     search.add_argument("--policy-draws", type=_count, default=12,
                         help="draws of the paper's start policy the 'policy', 'expected' and 'story' objectives walk "
                              "(default 12; a draw with t2 <= t1 is no window and costs no episode)")

@@ -7,61 +7,10 @@ the shipped gaits were found: "steady" (the first default) from a walker of an e
 `params.DEFAULT_CPG`/`DEFAULT_GAIT` by the "hold" objective (docs/MODEL.md).
 
 Score of a configuration that does not walk `distance_m` without a window: -9 + 8 * (the fraction of the
-distance it walked), so that a search from a gait that falls climbs towards one that walks. Of one that
-walks, by the objective:
-- "windows": the largest fractional C_mt saving among the scored windows that also walk (-0.3 if none
-  walks), plus 0.03 for every window that walks;
-- "walk": 0 (the search stops improving once a walker is found; use it to find one);
-- "coast": the same score over COAST_WINDOWS, the hip off from t1 = 0.2 ... 0.5 s until the swing foot
-  lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau);
-- "nearest": -(d / (1 + d) + f) / 3, d the CPG's distance from Table III (`distance_from_table_iii`) and f
-  how many of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through, to
-  find the walker whose CPG is nearest the paper's (with the "near_paper" mutations); in (-1, 0], so any
-  walker, however far, beats every fall, and one that survives both pushes beats every one that does not
-  (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push);
-- "floquet": (1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit
-  (`floquet.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map):
-  positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3;
-  FLOQUET_UNDEFINED (-1) when a perturbed step falls;
-- "policy": what the paper's learner climbs from its start: the expected reward of the policy
-  N((0.5, 0.5), 0.04 I) over POLICY_DRAWS (or `policy_draws`) fixed draws, relative to no window (a draw with t2 <= t1 is no
-  window and takes its reward), plus half the largest gain of a single drawn window;
-- "expected": the expected reward's gain alone, over the same draws (one drawn window that saves much cannot
-  carry a gait whose other draws fall);
-- "landscape": the same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s)
-  through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the
-  best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes
-  (stability's, without a window) the gait does not walk through;
-- "robust": how far the walk without a window is from holding when the simulation is refined or the start is
-  nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the
-  distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation
-  speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change
-  over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all
-  hold;
-- "story": the "robust" objective first, then what the paper's learner would find, judged where it holds: while
-  a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy"
-  objective with every draw's reward gain taken as the smaller of its gains at the step and at half the step
-  (each against no window at that step), the best draw's gain as the smallest of that and its gains from the
-  initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG's
-  distance from Table III (a tie-breaker towards the paper); from -1.01 up;
-- "hold": the "robust" objective first, then whether every window the paper's learner may end on holds: the hip
-  off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows'
-  t2 lie past the step's end, so the saving is a curve in t1), each walked as it is, at half the plant step and
-  from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies
-  past the powered step's end acts only when a step runs long, and once it acts the step runs long: two gaits,
-  chosen by the walk's details, that save much in one walk and little in the next. The learner's reach is every
-  window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window's (GARB's reward
-  is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the
-  means of GARB with the paper's settings ended on the gaits it has been run on, whatever their reward's peak:
-  500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one
-  of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the
-  smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus
-  0.1 x the mean over HOLD_WINDOWS of each window's smallest reward gain (a wider slope that holds), minus
-  0.01 d / (1 + d) as in "story";
-- "hold-long": the "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the
-  foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation
-  speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m:
-  the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).
+distance it walked), so that a search from a gait that falls climbs towards one that walks (the "robust",
+"story", "hold" and "hold-long" objectives score fallers themselves). Of one that walks, by the objective:
+OBJECTIVES, one entry per objective with its scoring function and what it scores (`drake-biped
+gait-search --help` prints them).
 
 Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them) or "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the
@@ -78,6 +27,7 @@ import dataclasses
 import json
 import math
 import random
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -147,8 +97,6 @@ COAST_MUTATIONS = {
 }
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
                  "coast": COAST_MUTATIONS}
-OBJECTIVES = ("windows", "walk", "policy", "expected", "nearest", "coast", "floquet", "landscape", "robust", "story",
-              "hold", "hold-long")
 # The "robust" objective's changes to the walk without a window, and the half step's allowed C_mt change.
 ROBUST_CHECKS = ("half_step", "speed_0.95", "speed_1.05", "push_forward", "push_backward")
 ROBUST_CMT_CHANGE = 0.02
@@ -405,46 +353,110 @@ def _hold_long_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                    "distance_from_table_iii": d}
 
 
-def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows",
-          draws: int = POLICY_DRAWS) -> tuple[float, dict[str, Any]]:
-    """The search objective (module docstring) and what it measured; `draws`: how many draws of the start
-    policy the "policy" and "expected" objectives walk."""
-    base = _walk(config.replace(window=TorqueFreeWindow()))
-    if objective == "robust":
-        return _robust_score(config, base)
-    if objective == "story":
-        return _story_score(config, base, draws)
-    if objective == "hold":
-        return _hold_score(config, base)
-    if objective == "hold-long":
-        return _hold_long_score(config, base)
-    if not base["walked"]:
-        return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
-            {"baseline": base, "windows": []}
-    if objective == "walk":
-        return 0.0, {"baseline": base, "windows": []}
-    if objective == "nearest":
-        d = distance_from_table_iii(config.cpg)
-        pushes = _push_rows(config)
-        failed = sum(not p["walked"] for p in pushes)
-        return -(d / (1.0 + d) + failed) / 3.0, {"baseline": base, "windows": [], "pushes": pushes,
-                                                "distance_from_table_iii": d}
-    if objective == "floquet":
-        return _orbit_score(config, base)
-    if objective == "landscape":
-        return _landscape_score(config, base)
-    if objective in ("policy", "expected"):
-        windows = policy_draws(draws)
-    elif objective == "coast":
-        windows = COAST_WINDOWS
+Score = Callable[[EpisodeConfig, dict[str, Any], Any, int], tuple[float, dict[str, Any]]]
+
+
+@dataclass(frozen=True)
+class Objective:
+    """A search objective: `score(config, base, windows, draws)` (base: the walk without a window) and what it
+    scores. `scores_fallers`: it scores a configuration that falls itself (else the fraction walked does)."""
+
+    score: Score
+    scores_fallers: bool
+    about: str
+
+
+def _windows_score(config, base, windows, draws):
     rows = _window_rows(config, windows, base)
-    if objective in ("policy", "expected", "coast"):
-        gains = [r["reward"] / base["reward"] - 1.0 for r in rows]
-        value = sum(gains) / len(gains) + (0.0 if objective == "expected" else 0.5 * max(0.0, max(gains)))
-        return value, {"baseline": base, "windows": rows}
     savings = [1.0 - r["cost_of_transport"] / base["cost_of_transport"] for r in rows if r["walked"]]
     value = (max(savings) if savings else -0.3) + 0.03 * len(savings)
     return value, {"baseline": base, "windows": rows}
+
+
+def _gain_score(config, base, windows, best_share: float):
+    rows = _window_rows(config, windows, base)
+    gains = [r["reward"] / base["reward"] - 1.0 for r in rows]
+    return sum(gains) / len(gains) + best_share * max(0.0, max(gains)), {"baseline": base, "windows": rows}
+
+
+def _walk_score(config, base, windows, draws):
+    return 0.0, {"baseline": base, "windows": []}
+
+
+def _policy_score(config, base, windows, draws):
+    return _gain_score(config, base, policy_draws(draws), 0.5)
+
+
+def _expected_score(config, base, windows, draws):
+    return _gain_score(config, base, policy_draws(draws), 0.0)
+
+
+def _coast_score(config, base, windows, draws):
+    return _gain_score(config, base, COAST_WINDOWS, 0.5)
+
+
+def _nearest_score(config, base, windows, draws):
+    d = distance_from_table_iii(config.cpg)
+    pushes = _push_rows(config)
+    failed = sum(not p["walked"] for p in pushes)
+    return -(d / (1.0 + d) + failed) / 3.0, {"baseline": base, "windows": [], "pushes": pushes,
+                                            "distance_from_table_iii": d}
+
+
+def _floquet_score(config, base, windows, draws):
+    return _orbit_score(config, base)
+
+
+def _landscape_objective(config, base, windows, draws):
+    return _landscape_score(config, base)
+
+
+def _robust_objective(config, base, windows, draws):
+    return _robust_score(config, base)
+
+
+def _story_objective(config, base, windows, draws):
+    return _story_score(config, base, draws)
+
+
+def _hold_objective(config, base, windows, draws):
+    return _hold_score(config, base)
+
+
+def _hold_long_objective(config, base, windows, draws):
+    return _hold_long_score(config, base)
+
+
+# Every objective a search can score by: its function and what it scores (the module docstring, the command's
+# help and the search's records read the names and the texts from here).
+OBJECTIVES: dict[str, Objective] = {
+    "windows": Objective(_windows_score, False, 'The largest fractional C_mt saving among the scored windows that also walk (-0.3 if none walks), plus 0.03 for every window that walks.'),
+    "walk": Objective(_walk_score, False, '0 (the search stops improving once a walker is found; use it to find one).'),
+    "policy": Objective(_policy_score, False, "What the paper's learner climbs from its start: the expected reward of the policy N((0.5, 0.5), 0.04 I) over POLICY_DRAWS (or `policy_draws`) fixed draws, relative to no window (a draw with t2 <= t1 is no window and takes its reward), plus half the largest gain of a single drawn window."),
+    "expected": Objective(_expected_score, False, "The expected reward's gain alone, over the same draws (one drawn window that saves much cannot carry a gait whose other draws fall)."),
+    "nearest": Objective(_nearest_score, False, '-(d / (1 + d) + f) / 3, d the CPG\'s distance from Table III (`distance_from_table_iii`) and f how many of the +-PUSH_FORCE_N pushes (stability\'s, without a window) the gait does not walk through, to find the walker whose CPG is nearest the paper\'s (with the "near_paper" mutations); in (-1, 0], so any walker, however far, beats every fall, and one that survives both pushes beats every one that does not (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push).'),
+    "coast": Objective(_coast_score, False, 'The same score over COAST_WINDOWS, the hip off from t1 = 0.2 ... 0.5 s until the swing foot lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau).'),
+    "floquet": Objective(_floquet_score, False, "(1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit (`floquet.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map): positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3; FLOQUET_UNDEFINED (-1) when a perturbed step falls."),
+    "landscape": Objective(_landscape_objective, False, "The same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s) through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through."),
+    "robust": Objective(_robust_objective, True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold."),
+    "story": Objective(_story_objective, True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
+    "hold": Objective(_hold_objective, True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
+    "hold-long": Objective(_hold_long_objective, True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
+}
+
+
+def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "windows",
+          draws: int = POLICY_DRAWS) -> tuple[float, dict[str, Any]]:
+    """The search objective `objective` (OBJECTIVES) and what it measured; `draws`: how many draws of the start
+    policy the "policy", "expected" and "story" objectives walk."""
+    if objective not in OBJECTIVES:
+        raise ParameterError(f"objective {objective!r} is not one of {list(OBJECTIVES)}")
+    spec = OBJECTIVES[objective]
+    base = _walk(config.replace(window=TorqueFreeWindow()))
+    if not spec.scores_fallers and not base["walked"]:
+        return -9.0 + 8.0 * min(1.0, max(0.0, base["distance_m"]) / config.sim.distance_m), \
+            {"baseline": base, "windows": []}
+    return spec.score(config, base, windows, draws)
 
 
 def _child(args) -> tuple[dict, float, dict]:
