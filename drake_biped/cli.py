@@ -9,7 +9,6 @@ takes the same `--workers N | --scheduler ADDR`.
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 from collections.abc import Callable, Iterator
@@ -18,157 +17,37 @@ from pathlib import Path
 
 from drake_biped.experiments import time_step as time_step_defaults
 from drake_biped.experiments.gait_search import OBJECTIVES
+from drake_biped.experiments.options import (  # noqa: F401  (number, integer, windows: the examples' option types)
+    MADE,
+    add_cluster_options,
+    add_episode_options,
+    add_model_option,
+    add_resumable_run_options,
+    add_window_options,
+    chosen_window,
+    cluster,
+    count,
+    episode_config,
+    integer,
+    learner_names,
+    number,
+    out_folder,
+    positive_list,
+    print_lines,
+    seed_type,
+    steps,
+    windows,
+    with_model,
+)
 from drake_biped.model import ModelError
-from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow, with_time_step
-from drake_biped.resources import gait_names, load_gait
-
-
-def number(kind: str):
-    """An option's type: a finite number, and for `kind` "positive" > 0, "nonnegative" >= 0 ("finite": any);
-    argparse reports a refusal as one line naming the option and the value."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
-        if kind == "positive" and value <= 0:
-            raise argparse.ArgumentTypeError(f"{text!r} must be > 0")
-        if kind == "nonnegative" and value < 0:
-            raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
-        return value
-
-    parse.__name__ = f"{kind} number"
-    return parse
-
-
-def integer(minimum: int):
-    """An option's type: an integer >= `minimum`."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"{text!r} must be >= {minimum}")
-        return value
-
-    parse.__name__ = f"integer >= {minimum}"
-    return parse
-
-
-def _out_folder(text: str) -> Path:
-    """--out: a folder that exists or can be made, and can be written; refused by name otherwise."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty path; name a folder (it is made if missing)")
-    path = Path(text)
-    if path.exists() and not path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
-    new = [p for p in (path, *path.parents) if not p.exists()]
-    _MADE.extend(reversed(new))  # removed again, if still empty, when the command refuses its input
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / ".drake-biped-write-test"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: cannot write there ({exc.strerror or exc})") from None
-    return path
-
-
-_MADE: list[Path] = []  # folders --out made in this invocation
-_seed = integer(0)
-_count = integer(1)
-
-
-def _add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
-    p.add_argument("--params", help=f"a shipped gait by name ({', '.join(gait_names())}) or a JSON file of "
-                   "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
-    p.add_argument("--distance", type=number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
-    p.add_argument("--max-time", type=number("positive"),
-                   help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
-    p.add_argument("--time-step", type=number("positive"),
-                   help="plant time step (s) (default: 0.001); the control period (1 ms) is kept, or becomes the "
-                        "step when the step is longer")
-    if slope_command:
-        p.add_argument("--slope", type=number("finite"), required=True,
-                       help="the ascending slope after the level part (rad, > 0)")
-        p.add_argument("--level-length", type=number("nonnegative"), default=2.0,
-                       help="level ground before the slope (m)")
-    else:
-        p.add_argument("--slope", type=number("finite"), help="ground slope (rad, > 0 ascends) (default: 0, level)")
-        p.add_argument("--level-length", type=number("nonnegative"),
-                       help="level ground for this many metres, then the slope (default: none, the slope everywhere)")
-    p.add_argument("--seed", type=_seed, default=None, help="recorded with the result (default: 0)")
-    _add_model_option(p)
-
-
-def _add_model_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--model", help="the robot: a URDF or SDFormat file with the shipped model's link and joint "
-                   "names (default: the shipped biped, or the --params file's); its content travels with the "
-                   "episodes and result.json records its name and SHA-256")
-
-
-def _with_model(config: EpisodeConfig, model_file: str | None) -> EpisodeConfig:
-    """`config` with the --model file's robot, checked (parsed and its body read) before any work starts."""
-    from drake_biped.model import body_of_model
-    from drake_biped.params import RobotModel
-
-    if model_file is not None:
-        config = config.replace(model=RobotModel.from_file(model_file))
-    if config.model is not None:
-        body_of_model(config.model)  # ModelError: one line, exit 2
-    return config
-
-
-# The longest time step (and control period) at which the default gait's walk has been measured to converge.
-CONVERGED_TIME_STEP_S = 0.002
-
-
-def _episode_config(args: argparse.Namespace) -> EpisodeConfig:
-    config = EpisodeConfig() if args.params is None else load_gait(args.params)
-    changes: dict[str, float] = {}
-    if args.distance is not None:
-        changes["sim.distance_m"] = args.distance
-        changes["sim.max_time_s"] = max(config.sim.max_time_s, 6.0 * args.distance)
-    if args.max_time is not None:
-        changes["sim.max_time_s"] = args.max_time
-    if args.time_step is not None:
-        sim = with_time_step(config.sim, args.time_step, "--time-step")
-        changes["sim.time_step_s"], changes["sim.control_period_s"] = sim.time_step_s, sim.control_period_s
-    if args.slope is not None:
-        changes["ground.slope_rad"] = args.slope
-    if args.level_length is not None:
-        changes["ground.level_length_m"] = args.level_length
-    config = _with_model(config.override(changes), args.model)
-    if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
-        print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
-              "steps at which the default gait's walk converges (docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its "
-              "control loop diverges, which ends an episode as 'diverged'", file=sys.stderr)
-    return config if args.seed is None else config.replace(seed=args.seed)
-
-
-@contextmanager
-def _client(args: argparse.Namespace):
-    """The Dask client of the cluster options: --scheduler ADDR, or a LocalCluster of --workers N."""
-    from drake_biped.experiments.executor import dask_client
-
-    with dask_client(workers=args.workers, scheduler=args.scheduler,
-                     force=args.force) as client:  # it checks the options first
-        yield client
-
-
-def _print(lines) -> None:
-    print("\n".join(lines))
+from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow
+from drake_biped.resources import load_gait
 
 
 def cmd_walk(args: argparse.Namespace) -> int:
     from drake_biped.experiments import walk
 
-    config = _episode_config(args)
+    config = episode_config(args)
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
     if args.t1 is not None:
@@ -183,9 +62,9 @@ def cmd_walk(args: argparse.Namespace) -> int:
     out = Path(args.out)
     result = walk.run(walk.WalkSettings(config, animation=not args.no_animation,
                                         save_trajectory=args.save_trajectory), out)
-    _print(walk.summary_lines(result))
+    print_lines(walk.summary_lines(result))
     if not args.no_animation:
-        _print(walk.animation_lines(out))
+        print_lines(walk.animation_lines(out))
     if config.push is not None and result.duration_s <= config.push.start_s:
         print(f"note: the episode ended at {result.duration_s:.2f} s, before the push at {config.push.start_s:g} s "
               "started: it walked unpushed", file=sys.stderr)
@@ -196,11 +75,11 @@ def cmd_walk(args: argparse.Namespace) -> int:
 def cmd_window_map(args: argparse.Namespace) -> int:
     from drake_biped.experiments import window_map
 
-    settings = window_map.WindowMapSettings(_episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
+    settings = window_map.WindowMapSettings(episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
                                             t1_step_s=args.step, t2_step_s=args.step, force=args.force)
-    with _client(args) as client:
+    with cluster(args) as client:
         record = window_map.run(settings, Path(args.out), client)
-    _print(window_map.summary_lines(record))
+    print_lines(window_map.summary_lines(record))
     print(f"wrote {args.out}/window_map.json, window_map.csv, window_map.png")
     return 0
 
@@ -208,13 +87,13 @@ def cmd_window_map(args: argparse.Namespace) -> int:
 def cmd_gait_search(args: argparse.Namespace) -> int:
     from drake_biped.experiments import gait_search
 
-    config = _episode_config(args)
+    config = episode_config(args)
     settings = gait_search.GaitSearchSettings(
         config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
         distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
         objective=args.objective, policy_draws=args.policy_draws)
     search = gait_search.run_cmaes if args.method == "cmaes" else gait_search.run
-    with _client(args) as client:
+    with cluster(args) as client:
         result = search(settings, Path(args.out), client)
     print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
     return 0
@@ -229,12 +108,12 @@ def cmd_time_step_study(args: argparse.Namespace) -> int:
     else:
         config = None if args.params is None else load_gait(args.params)
         if args.model is not None:
-            config = _with_model(config or EpisodeConfig(), args.model)
+            config = with_model(config or EpisodeConfig(), args.model)
         reference = min(args.steps) if args.reference is None else args.reference
         settings = time_step.TimeStepSettings(tuple(args.steps), reference, args.distance, config,
                                               "Default gait" if args.params is None else f"Gait {args.params}",
                                               None if args.windows is None else tuple(args.windows))
-        with _client(args) as client:
+        with cluster(args) as client:
             rec = time_step.run(settings, out, client)
     print((out / "time_step_study.md").read_text())
     chosen = rec["chosen_step_s"]
@@ -246,13 +125,13 @@ def cmd_compare_learners(args: argparse.Namespace) -> int:
     from drake_biped.experiments import compare_learners
 
     settings = compare_learners.CompareSettings(
-        _episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
+        episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
         episodes=args.episodes, seed=args.seed if args.seed is not None else 0)
     out = Path(args.out)
     compare_learners.check(settings, out)  # before a cluster starts
-    with _client(args) as client:
+    with cluster(args) as client:
         record = compare_learners.run(settings, out, client)
-    _print(compare_learners.summary_lines(record, out))
+    print_lines(compare_learners.summary_lines(record, out))
     return 0
 
 
@@ -260,7 +139,7 @@ def cmd_learn(args: argparse.Namespace) -> int:
     from drake_biped.experiments import learning
     from drake_biped.experiments.progress import check_run_log
 
-    config = _episode_config(args)
+    config = episode_config(args)
     settings = learning.LearningSettings(config, args.trials, args.episodes,
                                          args.seed if args.seed is not None else 0,
                                          mean=tuple(args.initial_mean), variance=args.variance,
@@ -269,10 +148,10 @@ def cmd_learn(args: argparse.Namespace) -> int:
     out = Path(args.out)
     learning.check_resume(record_settings, out)
     check_run_log(out, "learn")  # before a cluster starts
-    with _client(args) as client:
+    with cluster(args) as client:
         record = learning.run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler,
                               rewalk_distance_m=args.rewalk_distance)
-    _print(learning.summary_lines(record, out))
+    print_lines(learning.summary_lines(record, out))
     return 0
 
 
@@ -296,44 +175,20 @@ def cmd_landscape(args: argparse.Namespace) -> int:
                                            (tuple(args.start),) if args.start else ((0.5, 0.5),),
                                            samples=args.samples, seed=args.seed)
     record = landscape.run(settings, Path(args.out) if args.out else None)
-    _print(landscape.summary_lines(record))
+    print_lines(landscape.summary_lines(record))
     out = Path(args.out) if args.out else settings.path().parent
     print(f"wrote {out}/landscape.json, landscape.png")
     return 0
 
 
-def _policy_window(path: Path) -> tuple[float, float]:
-    """The learned torque-free period of a learning.json (`learning.best_learned_trial`)."""
-    from drake_biped.experiments.learning import best_learned_trial
-    from drake_biped.records import read_json
-
-    row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
-    return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
-
-
-def _chosen_window(args: argparse.Namespace) -> tuple[float, float]:
-    """The torque-free period to compare against none: --policy, or --t1/--t2, or 0.2-0.5 s."""
-    if args.policy is not None and args.t1 is not None:
-        raise ParameterError("give either --policy or --t1/--t2, not both")
-    if (args.t1 is None) != (args.t2 is None):
-        raise ParameterError("--t1 and --t2 go together: give both or neither")
-    if args.policy is not None:
-        return _policy_window(Path(args.policy))
-    if args.t1 is not None:
-        if args.t2 <= args.t1:
-            raise ParameterError(f"--t1 {args.t1} --t2 {args.t2}: need t1 < t2")
-        return args.t1, args.t2
-    return 0.2, 0.5
-
-
 def cmd_stability(args: argparse.Namespace) -> int:
     from drake_biped.experiments import stability
 
-    config = _episode_config(args)
-    settings = stability.StabilitySettings(window=_chosen_window(args), trials=args.trials,
+    config = episode_config(args)
+    settings = stability.StabilitySettings(window=chosen_window(args), trials=args.trials,
                                            push_force_n=args.push, spread=args.spread, seed=config.seed)
     out = Path(args.out)
-    with _client(args) as client:
+    with cluster(args) as client:
         stability.run(settings, out, client, config=config, floquet=args.floquet)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
     print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
@@ -344,13 +199,13 @@ def cmd_floquet(args: argparse.Namespace) -> int:
     from drake_biped.experiments import floquet
     from drake_biped.params import TorqueFreeWindow
 
-    config = _episode_config(args)
+    config = episode_config(args)
     if args.policy is not None or args.t1 is not None or args.t2 is not None:
-        config = config.replace(window=TorqueFreeWindow(*_chosen_window(args)))
+        config = config.replace(window=TorqueFreeWindow(*chosen_window(args)))
     settings = floquet.FloquetSettings(config, settle_steps=args.settle_steps,
                                        **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}))
     out = Path(args.out)
-    with _client(args) as client:
+    with cluster(args) as client:
         record = floquet.run(settings, out, client)
     from drake_biped.analysis.floquet import record_verdict
 
@@ -371,7 +226,7 @@ def cmd_rewalk(args: argparse.Namespace) -> int:
     # What is not a learning record is refused before a cluster starts.
     check_learning_record(read_json(Path(args.policy), "--policy"), f"--policy {args.policy}")
     out = Path(args.out)
-    with _client(args) as client:
+    with cluster(args) as client:
         record = rewalk_record(Path(args.policy), client)
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "rewalk.json", record)
@@ -384,14 +239,14 @@ def cmd_rewalk(args: argparse.Namespace) -> int:
 def cmd_push_margin(args: argparse.Namespace) -> int:
     from drake_biped.experiments import push_margin
 
-    config = _episode_config(args)
+    config = episode_config(args)
     if args.distance is None:  # a push at --settle s (about 6 m), then room to recover or fall
         config = config.override({"sim.distance_m": 12.0, "sim.max_time_s": max(config.sim.max_time_s, 72.0)})
-    settings = push_margin.PushMarginSettings(config, _chosen_window(args), max_force_n=args.max_force,
+    settings = push_margin.PushMarginSettings(config, chosen_window(args), max_force_n=args.max_force,
                                               force_step_n=args.force_step, phases=args.phases,
                                               settle_s=args.settle, force=args.force)
     out = Path(args.out)
-    with _client(args) as client:
+    with cluster(args) as client:
         push_margin.run(settings, out, client)
     print((out / "push_margin.md").read_text())
     print(f"wrote {out}/push_margin.json, push_margin.md, push_margin.png")
@@ -402,7 +257,7 @@ def cmd_grid(args: argparse.Namespace) -> int:
     from drake_biped.experiments import grid
     from drake_biped.experiments.progress import check_run_log
 
-    config = _episode_config(args)
+    config = episode_config(args)
     if args.spec is not None and args.points_per_axis is not None:
         raise ParameterError("give either --spec or --points-per-axis, not both")
     axes = grid.load_spec(args.spec) if args.spec is not None else grid.table_iv_axes(args.points_per_axis or 2)
@@ -411,9 +266,9 @@ def cmd_grid(args: argparse.Namespace) -> int:
     settings = grid.GridSettings(config, tuple(axes), force=args.force)
     out = Path(args.out)
     check_run_log(out, "grid")  # before a cluster starts
-    with _client(args) as client:
+    with cluster(args) as client:
         record = grid.run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
-    _print(grid.summary_lines(record, out))
+    print_lines(grid.summary_lines(record, out))
     return 0
 
 
@@ -424,7 +279,7 @@ def cmd_slope(args: argparse.Namespace) -> int:
     level = args.level_length
     args.level_length = None  # the slope ground is built by the slope settings, not by the episode options
     slope_rad, args.slope = args.slope, None
-    config = _episode_config(args)
+    config = episode_config(args)
     slope.slope_ground(slope_rad, level, config.ground.friction)  # refuse a bad slope before anything runs
     if args.policy is not None:
         if args.t1 is not None or args.t2 is not None:
@@ -432,13 +287,13 @@ def cmd_slope(args: argparse.Namespace) -> int:
         settings = slope.SlopeSettings(config, slope_rad, level, policy=str(args.policy), trials=args.trials,
                                        episodes=args.episodes, seed=config.seed)
     else:
-        settings = slope.SlopeSettings(config, slope_rad, level, window=_chosen_window(args),
+        settings = slope.SlopeSettings(config, slope_rad, level, window=chosen_window(args),
                                        variance=args.variance, trials=args.trials, episodes=args.episodes,
                                        seed=config.seed)
     settings.start()  # a --policy that cannot be read is refused before a cluster starts
     out = Path(args.out)
     check_run_log(out, "slope")
-    with _client(args) as client:
+    with cluster(args) as client:
         slope.run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
     print((out / "report.md").read_text())
     print(f"wrote {out}/slope.json, report.md, fig8_period.png, fig9_distance.png")
@@ -457,78 +312,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     print(f"reproduce ({profile.name}): {len(reproduce.steps_of(profile))} experiments into {out}/, expected "
           "about " + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
           + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
-    with _client(args) as client:
+    with cluster(args) as client:
         reproduce.run(reproduce.ReproduceSettings(profile), out, client, workers=args.workers,
                       scheduler=args.scheduler)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines()[:40] if line.startswith("|")))
     print(f"wrote {out}/report.md, report.html")
     return 0
-
-
-def _steps(text: str) -> list[float]:
-    parse = number("positive")
-    return [parse(t) for t in text.split(",")]
-
-
-def windows(text: str) -> list[tuple[float, float]]:
-    """An option's type: torque-free windows T1-T2 (s), comma-separated, each with 0 <= T1 < T2."""
-    parse = number("nonnegative")
-    out = []
-    for t in text.split(","):
-        ends = t.split("-")
-        if len(ends) != 2:
-            raise argparse.ArgumentTypeError(f"{t!r}: a window is T1-T2 in seconds, e.g. 0.3-0.7")
-        t1, t2 = parse(ends[0]), parse(ends[1])
-        if t2 <= t1:
-            raise argparse.ArgumentTypeError(f"{t!r}: T2 <= T1 is no window; give T1 < T2, e.g. 0.3-0.7")
-        out.append((t1, t2))
-    return out
-
-
-def _learner_names(text: str) -> list[str]:
-    from drake_biped.learners.registry import LEARNERS
-
-    names = [t.strip() for t in text.split(",")]
-    unknown = [n for n in names if n not in LEARNERS]
-    if unknown or not names or len(set(names)) != len(names):
-        raise argparse.ArgumentTypeError(f"{text!r}: a comma-separated list of distinct learners from "
-                                         f"{sorted(LEARNERS)}")
-    return names
-
-
-def _positive_list(text: str) -> list[float]:
-    try:
-        values = [float(t) for t in text.split(",")]
-    except ValueError:
-        values = []
-    if len(values) < 3 or not all(math.isfinite(v) and v > 0 for v in values):
-        raise argparse.ArgumentTypeError(f"{text!r}: at least three positive numbers, comma-separated")
-    return values
-
-
-def _add_window_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default 0.2")
-    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); default 0.5")
-    p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
-                   "(the trial with a window and the lowest C_mt)")
-
-
-def _add_cluster_options(p: argparse.ArgumentParser) -> None:
-    from drake_biped.experiments.executor import MAX_LOCAL_WORKERS_PER_CORE
-
-    p.add_argument("--workers", type=_count, default=None,
-                   help=f"local Dask workers (default: one per core; at most {MAX_LOCAL_WORKERS_PER_CORE} per core "
-                   "without --force)")
-    p.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
-    p.add_argument("--force", action="store_true",
-                   help="run what is refused as beyond this machine: more --workers than its limit, a grid "
-                   "over its point limit, a push-margin map over its episode limit")
-
-
-def _add_resumable_run_options(p: argparse.ArgumentParser) -> None:
-    """The cluster options and --out of a command that resumes when rerun."""
-    _add_cluster_options(p)
-    p.add_argument("--out", required=True, type=_out_folder, help="output folder (rerun the same command to resume)")
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -610,7 +399,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser = add_parser
 
     walk = sub.add_parser("walk", help="walk one episode and write its record, figures and animation")
-    _add_episode_options(walk)
+    add_episode_options(walk)
     walk.add_argument("--t1", type=number("nonnegative"),
                       help="torque-free start after each step start (s); with --t2 (default: no window)")
     walk.add_argument("--t2", type=number("nonnegative"), help="torque-free end (s), after --t1 (default: no window)")
@@ -620,23 +409,23 @@ def build_parser() -> argparse.ArgumentParser:
     walk.add_argument("--push-duration", type=number("positive"), default=0.1, help="push duration (s)")
     walk.add_argument("--save-trajectory", action="store_true", help="also write trajectory.npz")
     walk.add_argument("--no-animation", action="store_true", help="skip walk.html and walk.gif")
-    walk.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    walk.add_argument("--out", required=True, type=out_folder, help="output folder")
     walk.set_defaults(func=cmd_walk)
 
     wmap = sub.add_parser("window-map", help="C_mt of a grid of torque-free windows against no window")
-    _add_episode_options(wmap)
+    add_episode_options(wmap)
     wmap.add_argument("--step", type=number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
     wmap.add_argument("--t1-max", type=number("nonnegative"), default=0.6, help="largest start t1 (s)")
     wmap.add_argument("--t2-max", type=number("positive"), default=0.9, help="largest end t2 (s)")
-    _add_cluster_options(wmap)
-    wmap.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    add_cluster_options(wmap)
+    wmap.add_argument("--out", required=True, type=out_folder, help="output folder")
     wmap.set_defaults(func=cmd_window_map)
 
     search = sub.add_parser("gait-search", help="evolve gait parameters for walking and torque-free savings",
                             epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
-    _add_episode_options(search)
-    search.add_argument("--generations", type=_count, default=50, help="generations (default 50)")
-    search.add_argument("--offspring", type=_count, default=4, help="children per generation (default 4)")
+    add_episode_options(search)
+    search.add_argument("--generations", type=count, default=50, help="generations (default 50)")
+    search.add_argument("--offspring", type=count, default=4, help="children per generation (default 4)")
     search.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale (default 0.1)")
     search.add_argument("--mutations", choices=["default", "paper", "near_paper", "coast"], default="default",
                         help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
@@ -648,15 +437,15 @@ def build_parser() -> argparse.ArgumentParser:
                              "offspring candidates a generation")
     search.add_argument("--objective", default="windows", choices=list(OBJECTIVES),
                         help="what a walker scores (each objective's definition below)")
-    search.add_argument("--policy-draws", type=_count, default=12,
+    search.add_argument("--policy-draws", type=count, default=12,
                         help="draws of the paper's start policy the 'policy', 'expected' and 'story' objectives walk "
                              "(default 12; a draw with t2 <= t1 is no window and costs no episode)")
-    _add_resumable_run_options(search)
+    add_resumable_run_options(search)
     search.set_defaults(func=cmd_gait_search)
 
     ts = sub.add_parser("time-step-study", help="the long-run C_mt against the plant step (control period kept), "
                         "Richardson's limit, and the step they choose")
-    ts.add_argument("--steps", type=_steps, default=list(time_step_defaults.STEPS),
+    ts.add_argument("--steps", type=steps, default=list(time_step_defaults.STEPS),
                     help="plant steps (s), comma-separated (default 0.002,0.001,0.0005,0.00025,0.000125)")
     ts.add_argument("--reference", type=number("positive"), default=None,
                     help="reference step (s), one of --steps (default: the finest)")
@@ -665,23 +454,23 @@ def build_parser() -> argparse.ArgumentParser:
                          "over the rest")
     ts.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
                     "default gait. Its own time step is replaced by each of --steps")
-    _add_model_option(ts)
+    add_model_option(ts)
     ts.add_argument("--windows", type=windows,
                     help="the windows compared with none, T1-T2 in s, comma-separated (default "
                          "0.405096-0.944455,0.3-0.6: the default gait's learned window and one early in the swing)")
-    _add_cluster_options(ts)
+    add_cluster_options(ts)
     ts.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
-    ts.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    ts.add_argument("--out", required=True, type=out_folder, help="output folder")
     ts.set_defaults(func=cmd_time_step_study)
 
     learn = sub.add_parser("learn", help="learning of the torque-free period (Experiment 1: GARB), on Dask")
-    _add_episode_options(learn)
+    add_episode_options(learn)
     from drake_biped.learners.registry import LEARNERS
 
     learn.add_argument("--learner", choices=sorted(LEARNERS), default="garb",
                        help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
-    learn.add_argument("--trials", type=_count, default=5, help="independent trials (default 5)")
-    learn.add_argument("--episodes", type=_count, default=500, help="episodes per trial (default 500)")
+    learn.add_argument("--trials", type=count, default=5, help="independent trials (default 5)")
+    learn.add_argument("--episodes", type=count, default=500, help="episodes per trial (default 500)")
     learn.add_argument("--initial-mean", type=number("nonnegative"), nargs=2, default=[0.5, 0.5],
                        metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
     learn.add_argument("--variance", type=number("positive"), default=0.04,
@@ -690,107 +479,107 @@ def build_parser() -> argparse.ArgumentParser:
                        help="how far each final policy mean (and no window) is re-walked, as learned, at half the "
                             "step and from 0.95 / 1.05 x the initiation speed (m); from 110 m on, each walk's C_mt is "
                             "its long-run mean after the first 10 m (default: 110, or --distance when under 10 m)")
-    _add_resumable_run_options(learn)
+    add_resumable_run_options(learn)
     learn.set_defaults(func=cmd_learn)
 
     comp = sub.add_parser("compare-learners", help="learners side by side against the window map's best window")
-    _add_episode_options(comp)
+    add_episode_options(comp)
     comp.add_argument("--window-map", required=True,
                       help="the gait's window map (a window-map folder or its window_map.json): the known optimum")
-    comp.add_argument("--learners", type=_learner_names, default=["garb", "cmaes", "pgpe"],
+    comp.add_argument("--learners", type=learner_names, default=["garb", "cmaes", "pgpe"],
                       help="comma-separated (default garb,cmaes,pgpe)")
-    comp.add_argument("--trials", type=_count, default=5, help="trials per learner (default 5)")
-    comp.add_argument("--episodes", type=_count, default=300, help="episodes per trial (default 300)")
-    _add_resumable_run_options(comp)
+    comp.add_argument("--trials", type=count, default=5, help="trials per learner (default 5)")
+    comp.add_argument("--episodes", type=count, default=300, help="episodes per trial (default 300)")
+    add_resumable_run_options(comp)
     comp.set_defaults(func=cmd_compare_learners)
 
     land = sub.add_parser("landscape", help="the expected reward GARB climbs, from a window map, for given variances")
     land.add_argument("window_map", help="a window-map output folder or its window_map.json")
-    land.add_argument("--variance", type=_steps, default=[0.04, 0.01, 0.0025],
+    land.add_argument("--variance", type=steps, default=[0.04, 0.01, 0.0025],
                       help="policy variances (s^2), comma-separated; default 0.04,0.01,0.0025")
     land.add_argument("--start", type=number("nonnegative"), nargs=2, metavar=("T1", "T2"),
                       help="a policy start to evaluate (default 0.5 0.5)")
-    land.add_argument("--samples", type=_count, default=2000, help="Monte Carlo samples per mean (default 2000)")
-    land.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
-    land.add_argument("--out", default=None, type=_out_folder, help="output folder (default: the window map's)")
+    land.add_argument("--samples", type=count, default=2000, help="Monte Carlo samples per mean (default 2000)")
+    land.add_argument("--seed", type=seed_type, default=0, help="random seed (default 0)")
+    land.add_argument("--out", default=None, type=out_folder, help="output folder (default: the window map's)")
     land.set_defaults(func=cmd_landscape)
 
     stab = sub.add_parser("stability", help="pushes and Poincare return maps with and without a torque-free "
                           "period (Table VI, Fig. 7), on Dask")
-    _add_episode_options(stab)
-    _add_window_options(stab)
-    stab.add_argument("--trials", type=_count, default=8, help="trials per cell (default 8)")
+    add_episode_options(stab)
+    add_window_options(stab)
+    stab.add_argument("--trials", type=count, default=8, help="trials per cell (default 8)")
     stab.add_argument("--push", type=number("positive"), default=20.0, help="push force (N); default 20")
     stab.add_argument("--floquet", action="store_true",
                       help="also the periodic orbit's Floquet multipliers without and with the window (about a "
                       "minute each on 2 cores), in the report beside the regression")
     stab.add_argument("--spread", type=number("nonnegative"), default=0.15,
                       help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
-    _add_resumable_run_options(stab)
+    add_resumable_run_options(stab)
     stab.set_defaults(func=cmd_stability)
 
     pm = sub.add_parser("push-margin", help="pushes in steady state over a grid of forces and phases of the step, "
                         "with and without a torque-free period: the survival map and the margins (on Dask)")
-    _add_episode_options(pm)
-    _add_window_options(pm)
+    add_episode_options(pm)
+    add_window_options(pm)
     pm.add_argument("--max-force", type=number("positive"), default=100.0, help="largest push tried (N); default 100")
     pm.add_argument("--force-step", type=number("positive"), default=5.0,
                     help="spacing of the force grid (N); default 5")
-    pm.add_argument("--phases", type=_count, default=12, help="phases of the step pushed; default 12")
+    pm.add_argument("--phases", type=count, default=12, help="phases of the step pushed; default 12")
     pm.add_argument("--settle", type=number("positive"), default=5.0,
                     help="the step pushed is the first to start at or after this time (s); default 5")
-    _add_cluster_options(pm)
-    pm.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    add_cluster_options(pm)
+    pm.add_argument("--out", required=True, type=out_folder, help="output folder")
     pm.set_defaults(func=cmd_push_margin)
 
     rw = sub.add_parser("rewalk", help="a learning run's final policy means re-walked with the plant step halved "
                         "and from 0.95 and 1.05 x the initiation speed, each against no window under the same "
                         "change, on Dask")
     rw.add_argument("--policy", required=True, help="the learning.json of drake-biped learn")
-    _add_cluster_options(rw)
-    rw.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    add_cluster_options(rw)
+    rw.add_argument("--out", required=True, type=out_folder, help="output folder")
     rw.set_defaults(func=cmd_rewalk)
 
     fl = sub.add_parser("floquet", help="the gait's periodic orbit (Newton on the full-state step map) and its "
                         "Floquet multipliers by central differences through Drake, on Dask")
-    _add_episode_options(fl)
+    add_episode_options(fl)
     fl.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default: the gait's window")
     fl.add_argument("--t2", type=number("positive"), help="torque-free end (s); default: the gait's window")
     fl.add_argument("--policy", default=None, help="a learning.json: analyse its best learned torque-free period")
-    fl.add_argument("--settle-steps", type=_count, default=8,
+    fl.add_argument("--settle-steps", type=count, default=8,
                     help="touchdowns walked from the initiation before the search starts (default 8)")
-    fl.add_argument("--epsilons", type=_positive_list, default=None,
+    fl.add_argument("--epsilons", type=positive_list, default=None,
                     help="perturbation sizes of the sweep, comma-separated (default 1e-8 to 3e-3, half decades)")
-    _add_cluster_options(fl)
-    fl.add_argument("--out", required=True, type=_out_folder, help="output folder")
+    add_cluster_options(fl)
+    fl.add_argument("--out", required=True, type=out_folder, help="output folder")
     fl.set_defaults(func=cmd_floquet)
 
     grid = sub.add_parser("grid", help="grid search of CPG parameters and the initiation (Table IV), on Dask")
-    _add_episode_options(grid)
-    grid.add_argument("--points-per-axis", type=_count, default=None,
+    add_episode_options(grid)
+    grid.add_argument("--points-per-axis", type=count, default=None,
                       help="points per range (cell centres) of Table IV's five CPG parameters and the "
                       "initial hip angle (0-15.2 deg) and speed (0-0.35 m/s); default 2 (128 points)")
     grid.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
                       "{values: [...]}}, or a shipped one by name (around_default, slope_0.02, slope_2deg, tiny)")
-    _add_resumable_run_options(grid)
+    add_resumable_run_options(grid)
     grid.set_defaults(func=cmd_grid)
 
     sl = sub.add_parser("slope", help="slope adaptation: does the learned torque-free period climb, does none, "
                         "and does online GARB learning adapt it (Figs. 8-11), on Dask")
-    _add_episode_options(sl, slope_command=True)
-    _add_window_options(sl)
+    add_episode_options(sl, slope_command=True)
+    add_window_options(sl)
     sl.add_argument("--variance", type=number("positive"), default=0.04,
                     help="the policy's variance (s^2) when starting from --t1/--t2; default 0.04 as in the paper "
                     "(--policy carries its own)")
-    sl.add_argument("--episodes", type=_count, default=100, help="learning episodes per trial (default 100)")
-    sl.add_argument("--trials", type=_count, default=2, help="independent learning trials (default 2)")
-    _add_resumable_run_options(sl)
+    sl.add_argument("--episodes", type=count, default=100, help="learning episodes per trial (default 100)")
+    sl.add_argument("--trials", type=count, default=2, help="independent learning trials (default 2)")
+    add_resumable_run_options(sl)
     sl.set_defaults(func=cmd_slope)
 
     rep = sub.add_parser("reproduce", help="every experiment of the paper and one report beside its numbers "
                          "(--quick: small settings, minutes)")
     rep.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
-    _add_resumable_run_options(rep)
+    add_resumable_run_options(rep)
     rep.set_defaults(func=cmd_reproduce)
 
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
@@ -932,12 +721,12 @@ def _failures_as_one_line(prefix: str, debug: bool, again: str,
 
 
 def _remove_empty_made_folders() -> None:
-    for folder in reversed(_MADE):
+    for folder in reversed(MADE):
         try:
             folder.rmdir()  # only an empty folder goes
         except OSError:
             pass
-    _MADE.clear()
+    MADE.clear()
 
 
 def _exit(code: int, message: str) -> None:

@@ -1,0 +1,248 @@
+"""The options the commands share and the types that check them, for `drake_biped.cli` and the experiments'
+own command-line parts: every numeric option validated at the boundary with a message that names the option
+and the value; the episode options that build an EpisodeConfig; the window options; the cluster options."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+from drake_biped.params import EpisodeConfig, ParameterError, with_time_step
+from drake_biped.resources import gait_names, load_gait
+
+
+def number(kind: str):
+    """An option's type: a finite number, and for `kind` "positive" > 0, "nonnegative" >= 0 ("finite": any);
+    argparse reports a refusal as one line naming the option and the value."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+        if kind == "positive" and value <= 0:
+            raise argparse.ArgumentTypeError(f"{text!r} must be > 0")
+        if kind == "nonnegative" and value < 0:
+            raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
+        return value
+
+    parse.__name__ = f"{kind} number"
+    return parse
+
+
+def integer(minimum: int):
+    """An option's type: an integer >= `minimum`."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r} must be >= {minimum}")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
+
+
+def out_folder(text: str) -> Path:
+    """--out: a folder that exists or can be made, and can be written; refused by name otherwise."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; name a folder (it is made if missing)")
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    new = [p for p in (path, *path.parents) if not p.exists()]
+    MADE.extend(reversed(new))  # removed again, if still empty, when the command refuses its input
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".drake-biped-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
+MADE: list[Path] = []  # folders --out made in this invocation
+seed_type = integer(0)
+count = integer(1)
+
+
+def add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False) -> None:
+    p.add_argument("--params", help=f"a shipped gait by name ({', '.join(gait_names())}) or a JSON file of "
+                   "EpisodeConfig fields (cpg, gait, initial, ...) or a result.json")
+    p.add_argument("--distance", type=number("positive"), help="walk this far (m) (default: 10, or the --params file's)")
+    p.add_argument("--max-time", type=number("positive"),
+                   help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
+    p.add_argument("--time-step", type=number("positive"),
+                   help="plant time step (s) (default: 0.001); the control period (1 ms) is kept, or becomes the "
+                        "step when the step is longer")
+    if slope_command:
+        p.add_argument("--slope", type=number("finite"), required=True,
+                       help="the ascending slope after the level part (rad, > 0)")
+        p.add_argument("--level-length", type=number("nonnegative"), default=2.0,
+                       help="level ground before the slope (m)")
+    else:
+        p.add_argument("--slope", type=number("finite"), help="ground slope (rad, > 0 ascends) (default: 0, level)")
+        p.add_argument("--level-length", type=number("nonnegative"),
+                       help="level ground for this many metres, then the slope (default: none, the slope everywhere)")
+    p.add_argument("--seed", type=seed_type, default=None, help="recorded with the result (default: 0)")
+    add_model_option(p)
+
+
+def add_model_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--model", help="the robot: a URDF or SDFormat file with the shipped model's link and joint "
+                   "names (default: the shipped biped, or the --params file's); its content travels with the "
+                   "episodes and result.json records its name and SHA-256")
+
+
+def with_model(config: EpisodeConfig, model_file: str | None) -> EpisodeConfig:
+    """`config` with the --model file's robot, checked (parsed and its body read) before any work starts."""
+    from drake_biped.model import body_of_model
+    from drake_biped.params import RobotModel
+
+    if model_file is not None:
+        config = config.replace(model=RobotModel.from_file(model_file))
+    if config.model is not None:
+        body_of_model(config.model)  # ModelError: one line, exit 2
+    return config
+
+
+# The longest time step (and control period) at which the default gait's walk has been measured to converge.
+CONVERGED_TIME_STEP_S = 0.002
+
+
+def episode_config(args: argparse.Namespace) -> EpisodeConfig:
+    config = EpisodeConfig() if args.params is None else load_gait(args.params)
+    changes: dict[str, float] = {}
+    if args.distance is not None:
+        changes["sim.distance_m"] = args.distance
+        changes["sim.max_time_s"] = max(config.sim.max_time_s, 6.0 * args.distance)
+    if args.max_time is not None:
+        changes["sim.max_time_s"] = args.max_time
+    if args.time_step is not None:
+        sim = with_time_step(config.sim, args.time_step, "--time-step")
+        changes["sim.time_step_s"], changes["sim.control_period_s"] = sim.time_step_s, sim.control_period_s
+    if args.slope is not None:
+        changes["ground.slope_rad"] = args.slope
+    if args.level_length is not None:
+        changes["ground.level_length_m"] = args.level_length
+    config = with_model(config.override(changes), args.model)
+    if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
+        print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
+              "steps at which the default gait's walk converges (docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its "
+              "control loop diverges, which ends an episode as 'diverged'", file=sys.stderr)
+    return config if args.seed is None else config.replace(seed=args.seed)
+
+
+@contextmanager
+def cluster(args: argparse.Namespace):
+    """The Dask client of the cluster options: --scheduler ADDR, or a LocalCluster of --workers N."""
+    from drake_biped.experiments.executor import dask_client
+
+    with dask_client(workers=args.workers, scheduler=args.scheduler,
+                     force=args.force) as client:  # it checks the options first
+        yield client
+
+
+def print_lines(lines) -> None:
+    print("\n".join(lines))
+
+
+def policy_window(path: Path) -> tuple[float, float]:
+    """The learned torque-free period of a learning.json (`learning.best_learned_trial`)."""
+    from drake_biped.experiments.learning import best_learned_trial
+    from drake_biped.records import read_json
+
+    row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
+    return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
+
+
+def chosen_window(args: argparse.Namespace) -> tuple[float, float]:
+    """The torque-free period to compare against none: --policy, or --t1/--t2, or 0.2-0.5 s."""
+    if args.policy is not None and args.t1 is not None:
+        raise ParameterError("give either --policy or --t1/--t2, not both")
+    if (args.t1 is None) != (args.t2 is None):
+        raise ParameterError("--t1 and --t2 go together: give both or neither")
+    if args.policy is not None:
+        return policy_window(Path(args.policy))
+    if args.t1 is not None:
+        if args.t2 <= args.t1:
+            raise ParameterError(f"--t1 {args.t1} --t2 {args.t2}: need t1 < t2")
+        return args.t1, args.t2
+    return 0.2, 0.5
+
+
+def steps(text: str) -> list[float]:
+    parse = number("positive")
+    return [parse(t) for t in text.split(",")]
+
+
+def windows(text: str) -> list[tuple[float, float]]:
+    """An option's type: torque-free windows T1-T2 (s), comma-separated, each with 0 <= T1 < T2."""
+    parse = number("nonnegative")
+    out = []
+    for t in text.split(","):
+        ends = t.split("-")
+        if len(ends) != 2:
+            raise argparse.ArgumentTypeError(f"{t!r}: a window is T1-T2 in seconds, e.g. 0.3-0.7")
+        t1, t2 = parse(ends[0]), parse(ends[1])
+        if t2 <= t1:
+            raise argparse.ArgumentTypeError(f"{t!r}: T2 <= T1 is no window; give T1 < T2, e.g. 0.3-0.7")
+        out.append((t1, t2))
+    return out
+
+
+def learner_names(text: str) -> list[str]:
+    from drake_biped.learners.registry import LEARNERS
+
+    names = [t.strip() for t in text.split(",")]
+    unknown = [n for n in names if n not in LEARNERS]
+    if unknown or not names or len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(f"{text!r}: a comma-separated list of distinct learners from "
+                                         f"{sorted(LEARNERS)}")
+    return names
+
+
+def positive_list(text: str) -> list[float]:
+    try:
+        values = [float(t) for t in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) < 3 or not all(math.isfinite(v) and v > 0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: at least three positive numbers, comma-separated")
+    return values
+
+
+def add_window_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default 0.2")
+    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); default 0.5")
+    p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
+                   "(the trial with a window and the lowest C_mt)")
+
+
+def add_cluster_options(p: argparse.ArgumentParser) -> None:
+    from drake_biped.experiments.executor import MAX_LOCAL_WORKERS_PER_CORE
+
+    p.add_argument("--workers", type=count, default=None,
+                   help=f"local Dask workers (default: one per core; at most {MAX_LOCAL_WORKERS_PER_CORE} per core "
+                   "without --force)")
+    p.add_argument("--scheduler", default=None, help="use a running Dask scheduler, e.g. tcp://HOST:8786")
+    p.add_argument("--force", action="store_true",
+                   help="run what is refused as beyond this machine: more --workers than its limit, a grid "
+                   "over its point limit, a push-margin map over its episode limit")
+
+
+def add_resumable_run_options(p: argparse.ArgumentParser) -> None:
+    """The cluster options and --out of a command that resumes when rerun."""
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder (rerun the same command to resume)")
+
+
