@@ -51,8 +51,9 @@ def test_a_second_command_into_a_busy_folder_is_refused_and_the_first_finishes_w
 
     def first():
         import drake_biped.cli as cli
+        from drake_biped.experiments import walk
 
-        real = cli.cmd_walk
+        real = walk.command
 
         def slow(args):
             started.set()

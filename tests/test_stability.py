@@ -235,7 +235,8 @@ def test_finite_difference_jacobian_recovers_a_known_step_map():
 
 
 def test_policy_option_takes_the_best_learned_window(tmp_path, capsys):
-    from drake_biped.cli import _policy_window, main
+    from drake_biped.cli import main
+    from drake_biped.experiments.options import policy_window as _policy_window
 
     learned = [{"trial": 0, "t1": 0.5, "t2": 0.3, "cost_of_transport": 0.221, "fell": False},
                {"trial": 1, "t1": 0.14, "t2": 0.30, "cost_of_transport": 0.144, "fell": False},

@@ -12,12 +12,22 @@ them again; OUT/compare.json, compare.md and compare.png put them side by side
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.learner_comparison import RUNNING, best_walking_window, compare
 from drake_biped.analysis.series import signed_percent
+from drake_biped.experiments.options import (
+    add_episode_options,
+    add_resumable_run_options,
+    cluster,
+    count,
+    episode_config,
+    learner_names,
+    print_lines,
+)
 from drake_biped.paper import GARB_MEAN_S, GARB_VARIANCE_S2
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import read_json, write_atomic, write_text_atomic
@@ -157,3 +167,33 @@ def markdown(record: dict[str, Any]) -> str:
 
 def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     return [markdown(record), f"wrote {out}/compare.json, compare.md, compare.png and one learning run per learner"]
+
+
+# The command line: `drake-biped compare-learners` (drake_biped/cli.py runs `command`).
+COMMAND = "compare-learners"
+PARSER = dict(help="learners side by side against the window map's best window")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped compare-learners`'s options."""
+    add_episode_options(p)
+    p.add_argument("--window-map", required=True,
+                   help="the gait's window map (a window-map folder or its window_map.json): the known optimum")
+    p.add_argument("--learners", type=learner_names, default=["garb", "cmaes", "pgpe"],
+                   help="comma-separated (default garb,cmaes,pgpe)")
+    p.add_argument("--trials", type=count, default=5, help="trials per learner (default 5)")
+    p.add_argument("--episodes", type=count, default=300, help="episodes per trial (default 300)")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = CompareSettings(
+        episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
+        episodes=args.episodes, seed=args.seed if args.seed is not None else 0)
+    out = Path(args.out)
+    check(settings, out)  # before a cluster starts
+    with cluster(args) as client:
+        record = run(settings, out, client)
+    print_lines(summary_lines(record, out))
+    return 0

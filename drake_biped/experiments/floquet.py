@@ -11,6 +11,7 @@ the difference between them is measured as the gait's sensitivity to the samplin
 
 from __future__ import annotations
 
+import argparse
 import math
 import time
 from dataclasses import dataclass, field
@@ -21,6 +22,17 @@ import numpy as np
 
 from drake_biped.analysis import floquet as fq
 from drake_biped.analysis.return_map import complex_list
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    add_episode_options,
+    chosen_window,
+    cluster,
+    count,
+    episode_config,
+    number,
+    out_folder,
+    positive_list,
+)
 from drake_biped.params import EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
@@ -290,3 +302,46 @@ def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
     write_text_atomic(out / "floquet.md", markdown(record))
     figure(record, out / "floquet.png")
     return record
+
+
+# The command line: `drake-biped floquet` (drake_biped/cli.py runs `command`).
+COMMAND = "floquet"
+PARSER = dict(help="the gait's periodic orbit (Newton on the full-state step map) and its "
+                        "Floquet multipliers by central differences through Drake, on Dask")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped floquet`'s options."""
+    add_episode_options(p)
+    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default: the gait's window")
+    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); default: the gait's window")
+    p.add_argument("--policy", default=None, help="a learning.json: analyse its best learned torque-free period")
+    p.add_argument("--settle-steps", type=count, default=8,
+                   help="touchdowns walked from the initiation before the search starts (default 8)")
+    p.add_argument("--epsilons", type=positive_list, default=None,
+                   help="perturbation sizes of the sweep, comma-separated (default 1e-8 to 3e-3, half decades)")
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.params import TorqueFreeWindow
+
+    config = episode_config(args)
+    if args.policy is not None or args.t1 is not None or args.t2 is not None:
+        config = config.replace(window=TorqueFreeWindow(*chosen_window(args)))
+    settings = FloquetSettings(config, settle_steps=args.settle_steps,
+                                       **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}))
+    out = Path(args.out)
+    with cluster(args) as client:
+        record = run(settings, out, client)
+    from drake_biped.analysis.floquet import record_verdict
+
+    epsilon = record["converged_epsilon"]
+    print(f"spectral radius {record['spectral_radius']:.4f}, fixed-point residual "
+          f"{record['fixed_point_residual']:.1e}, "
+          + ("no perturbation converged" if epsilon is None else f"converged at epsilon {epsilon:g}")
+          + f": {record_verdict(record)}")
+    print(f"wrote {out}/floquet.json, floquet.md, floquet.png")
+    return 0

@@ -23,6 +23,7 @@ generation are scored in parallel on Dask (`executor`).
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -32,6 +33,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from drake_biped.experiments.options import (
+    add_episode_options,
+    add_resumable_run_options,
+    cluster,
+    count,
+    episode_config,
+    number,
+)
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
@@ -690,3 +699,45 @@ def _append(path: Path, record: dict) -> None:
     with open(path, "a") as f:
         f.write(json.dumps(record) + "\n")
         f.flush()
+
+
+# The command line: `drake-biped gait-search` (drake_biped/cli.py runs `command`).
+COMMAND = "gait-search"
+PARSER = dict(help="evolve gait parameters for walking and torque-free savings",
+                            epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped gait-search`'s options."""
+    add_episode_options(p)
+    p.add_argument("--generations", type=count, default=50, help="generations (default 50)")
+    p.add_argument("--offspring", type=count, default=4, help="children per generation (default 4)")
+    p.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale (default 0.1)")
+    p.add_argument("--mutations", choices=["default", "paper", "near_paper", "coast"], default="default",
+                   help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
+                   "the paper does not print: the CPG and the initiation held), 'near_paper' (those "
+                   "and u_a, u_r, kappa) or 'coast' (default, the knee's hold torque, the torso's "
+                   "gains and the stance knee)")
+    p.add_argument("--method", choices=["es", "cmaes"], default="es",
+                   help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
+                   "offspring candidates a generation")
+    p.add_argument("--objective", default="windows", choices=list(OBJECTIVES),
+                   help="what a walker scores (each objective's definition below)")
+    p.add_argument("--policy-draws", type=count, default=12,
+                   help="draws of the paper's start policy the 'policy', 'expected' and 'story' objectives walk "
+                   "(default 12; a draw with t2 <= t1 is no window and costs no episode)")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    config = episode_config(args)
+    settings = GaitSearchSettings(
+        config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
+        distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
+        objective=args.objective, policy_draws=args.policy_draws)
+    search = run_cmaes if args.method == "cmaes" else run
+    with cluster(args) as client:
+        result = search(settings, Path(args.out), client)
+    print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
+    return 0

@@ -17,6 +17,7 @@ killed while writing) is ignored and its point rerun.
 
 from __future__ import annotations
 
+import argparse
 import csv
 import dataclasses
 import hashlib
@@ -30,6 +31,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from drake_biped.experiments.options import (
+    add_episode_options,
+    add_resumable_run_options,
+    cluster,
+    count,
+    episode_config,
+    print_lines,
+)
 from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
 from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import warn, write_atomic, write_text_atomic
@@ -340,3 +349,38 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     return [f"{record['walked_the_distance']}/{record['points']} points walk {distance:g} m; best "
             f"{', '.join(f'{k}={v:.4g}' for k, v in best['point'].items())}: {best['distance_m']:.2f} m, C_mt {cmt}",
             f"wrote {out}/grid.csv, grid.json, grid_slices.png, best_params.json (use --params)"]
+
+
+# The command line: `drake-biped grid` (drake_biped/cli.py runs `command`).
+COMMAND = "grid"
+PARSER = dict(help="grid search of CPG parameters and the initiation (Table IV), on Dask")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped grid`'s options."""
+    add_episode_options(p)
+    p.add_argument("--points-per-axis", type=count, default=None,
+                   help="points per range (cell centres) of Table IV's five CPG parameters and the "
+                   "initial hip angle (0-15.2 deg) and speed (0-0.35 m/s); default 2 (128 points)")
+    p.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
+                   "{values: [...]}}, or a shipped one by name (around_default, slope_0.02, slope_2deg, tiny)")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.experiments.progress import check_run_log
+
+    config = episode_config(args)
+    if args.spec is not None and args.points_per_axis is not None:
+        raise ParameterError("give either --spec or --points-per-axis, not both")
+    axes = load_spec(args.spec) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
+    source = f"--spec {args.spec}" if args.spec is not None else f"--points-per-axis {args.points_per_axis or 2}"
+    check_size(axes, args.force, source, "--force")  # before anything is built or started
+    settings = GridSettings(config, tuple(axes), force=args.force)
+    out = Path(args.out)
+    check_run_log(out, "grid")  # before a cluster starts
+    with cluster(args) as client:
+        record = run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
+    print_lines(summary_lines(record, out))
+    return 0

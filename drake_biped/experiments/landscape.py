@@ -3,12 +3,21 @@ landscape.png, for the policy variances asked. Reads records only; simulates not
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.landscape import WindowRewards, landscape
 from drake_biped.analysis.series import signed_percent
+from drake_biped.experiments.options import (
+    count,
+    number,
+    out_folder,
+    print_lines,
+    seed_type,
+    steps,
+)
 from drake_biped.params import ParameterError, check_settings
 from drake_biped.records import write_atomic
 from drake_biped.versions import versions
@@ -64,3 +73,32 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
                      f"{cell['best_mean'][1]:.3f}) expected reward {signed_percent(cell['best_gain'])} vs no window; "
                      f"at the start {tuple(s['mean'])} {signed_percent(s['gain'])}")
     return lines
+
+
+# The command line: `drake-biped landscape` (drake_biped/cli.py runs `command`).
+COMMAND = "landscape"
+PARSER = dict(help="the expected reward GARB climbs, from a window map, for given variances")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped landscape`'s options."""
+    p.add_argument("window_map", help="a window-map output folder or its window_map.json")
+    p.add_argument("--variance", type=steps, default=[0.04, 0.01, 0.0025],
+                   help="policy variances (s^2), comma-separated; default 0.04,0.01,0.0025")
+    p.add_argument("--start", type=number("nonnegative"), nargs=2, metavar=("T1", "T2"),
+                   help="a policy start to evaluate (default 0.5 0.5)")
+    p.add_argument("--samples", type=count, default=2000, help="Monte Carlo samples per mean (default 2000)")
+    p.add_argument("--seed", type=seed_type, default=0, help="random seed (default 0)")
+    p.add_argument("--out", default=None, type=out_folder, help="output folder (default: the window map's)")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = LandscapeSettings(args.window_map, tuple(args.variance),
+                                           (tuple(args.start),) if args.start else ((0.5, 0.5),),
+                                           samples=args.samples, seed=args.seed)
+    record = run(settings, Path(args.out) if args.out else None)
+    print_lines(summary_lines(record))
+    out = Path(args.out) if args.out else settings.path().parent
+    print(f"wrote {out}/landscape.json, landscape.png")
+    return 0

@@ -26,6 +26,7 @@ means no torque-free period, as in the paper.
 
 from __future__ import annotations
 
+import argparse
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -36,6 +37,16 @@ import numpy as np
 
 from drake_biped.analysis.rewalks import measured_cost
 from drake_biped.analysis.reward import reward
+from drake_biped.experiments.learning_record import best_learned_trial, check_learning_record
+from drake_biped.experiments.options import (
+    add_episode_options,
+    add_resumable_run_options,
+    cluster,
+    count,
+    episode_config,
+    number,
+    print_lines,
+)
 from drake_biped.experiments.rewalk import REWALK_M, rewalk, window_of
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.registry import learner_from_state, make_learner
@@ -47,7 +58,7 @@ from drake_biped.paper import (
     LEARNING_TRIALS,
     TABLE_II,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, config_of_record
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
 from drake_biped.records import read_json, write_atomic
 from drake_biped.versions import versions
 
@@ -207,52 +218,6 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
 
 
 # What the learning figures and Table V read of each recorded episode.
-EPISODE_FIELDS = ("reward", "cost_of_transport", "fell", "t1", "t2", "mean_t1", "mean_t2")
-
-
-def check_learning_record(record: Any, source: str = "learning.json") -> dict[str, Any]:
-    """`record` when it holds what the figures are drawn from (trials, each with its number and episodes of
-    EPISODE_FIELDS, and the settings' distance); otherwise ParameterError naming `source` and what is missing."""
-
-    def refuse(what: str):
-        raise ParameterError(f"{source}: not a learning record (the learning.json of drake-biped learn): {what}")
-
-    if not isinstance(record, dict):
-        refuse(f"it holds a JSON {type(record).__name__}, not an object")
-    trials = record.get("trials")
-    if not isinstance(trials, list) or not trials:
-        refuse("it has no 'trials' list" if "trials" not in record else "its 'trials' is not a non-empty list")
-    for k, trial in enumerate(trials):
-        episodes = trial.get("episodes") if isinstance(trial, dict) else None
-        if not isinstance(episodes, list) or not episodes or "trial" not in trial:
-            refuse(f"trials[{k}] is not a trial with its number and episodes")
-        for i, episode in enumerate(episodes):
-            missing = [f for f in EPISODE_FIELDS if not isinstance(episode, dict) or f not in episode]
-            if missing:
-                refuse(f"trials[{k}], episode {i + 1} has no {', '.join(map(repr, missing))}")
-    try:
-        float(record["settings"]["config"]["sim"]["distance_m"])
-    except (KeyError, TypeError, ValueError):
-        refuse("it has no settings.config.sim.distance_m")
-    return record
-
-
-def best_learned_trial(record: dict[str, Any], source: str = "learning.json") -> dict[str, Any]:
-    """The learned torque-free period of a learning record: of the trials whose final policy mean has a
-    window (t̄2 > t̄1) and walked the distance in the evaluation, the one with the lowest C_mt (a mean over
-    trials would blend trials that learned a window with trials that learned none). Its evaluation row
-    (trial, t1, t2, cost_of_transport, ...); ParameterError if there is none."""
-    try:
-        rows = [r for r in record["evaluation"]["learned"]
-                if not r["fell"] and r["cost_of_transport"] is not None and float(r["t2"]) > max(0.0, float(r["t1"]))]
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ParameterError(f"{source}: not a learning record with an evaluation ({exc})") from None
-    if not rows:
-        raise ParameterError(f"{source}: no trial learned a torque-free period that walks "
-                             "(every final mean has t2 <= t1)")
-    return min(rows, key=lambda r: float(r["cost_of_transport"]))
-
-
 def replay_run(source: Path, out: Path, settings: dict[str, Any]) -> bool:
     """Write into `out` the trial records of the run `settings` from a run in `source` with the same fixed
     settings and at least as many trials and episodes: each trial's first settings["episodes"] episodes, its
@@ -520,18 +485,46 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     return lines
 
 
-def rewalk_record(source: Path, client) -> dict[str, Any]:
-    """The re-walks of a learning record's final policy means (`source`: a learning.json), with what they
-    were made from."""
-    record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
-    try:
-        config = config_of_record(record["settings"]["config"])
-        learned = [{"trial": int(t["trial"]), "t1": float(t["final_mean"][0]), "t2": float(t["final_mean"][1])}
-                   for t in record["trials"]]
-    except (KeyError, TypeError, ValueError, IndexError) as exc:
-        raise ParameterError(f"--policy {source}: a learning record without its final means ({exc})") from None
-    # walked as the record's own re-walks were (a record from before re-walks were long: its episodes' length)
-    before = (record.get("evaluation") or {}).get("rewalks") or {}
-    distance = before.get("distance_m", config.sim.distance_m)
-    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client, distance),
-            "versions": versions()}
+# The command line: `drake-biped learn` (drake_biped/cli.py runs `command`).
+COMMAND = "learn"
+PARSER = dict(help="learning of the torque-free period (Experiment 1: GARB), on Dask")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped learn`'s options."""
+    add_episode_options(p)
+    from drake_biped.learners.registry import LEARNERS
+
+    p.add_argument("--learner", choices=sorted(LEARNERS), default="garb",
+                   help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
+    p.add_argument("--trials", type=count, default=5, help="independent trials (default 5)")
+    p.add_argument("--episodes", type=count, default=500, help="episodes per trial (default 500)")
+    p.add_argument("--initial-mean", type=number("nonnegative"), nargs=2, default=[0.5, 0.5],
+                   metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
+    p.add_argument("--variance", type=number("positive"), default=0.04,
+                   help="the policy's variance per time (s^2); default 0.04 as in the paper")
+    p.add_argument("--rewalk-distance", type=number("positive"), default=None,
+                   help="how far each final policy mean (and no window) is re-walked, as learned, at half the "
+                   "step and from 0.95 / 1.05 x the initiation speed (m); from 110 m on, each walk's C_mt is "
+                   "its long-run mean after the first 10 m (default: 110, or --distance when under 10 m)")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.experiments.progress import check_run_log
+
+    config = episode_config(args)
+    settings = LearningSettings(config, args.trials, args.episodes,
+                                         args.seed if args.seed is not None else 0,
+                                         mean=tuple(args.initial_mean), variance=args.variance,
+                                         learner=args.learner)
+    record_settings = settings.record()  # validated before a cluster starts
+    out = Path(args.out)
+    check_resume(record_settings, out)
+    check_run_log(out, "learn")  # before a cluster starts
+    with cluster(args) as client:
+        record = run(record_settings, out, client, workers=args.workers, scheduler=args.scheduler,
+                              rewalk_distance_m=args.rewalk_distance)
+    print_lines(summary_lines(record, out))
+    return 0

@@ -157,8 +157,8 @@ def print_lines(lines) -> None:
 
 
 def policy_window(path: Path) -> tuple[float, float]:
-    """The learned torque-free period of a learning.json (`learning.best_learned_trial`)."""
-    from drake_biped.experiments.learning import best_learned_trial
+    """The learned torque-free period of a learning.json (`learning_record.best_learned_trial`)."""
+    from drake_biped.experiments.learning_record import best_learned_trial
     from drake_biped.records import read_json
 
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")

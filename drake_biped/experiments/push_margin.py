@@ -13,12 +13,24 @@ condition and direction is the largest grid force at and below which every force
 
 from __future__ import annotations
 
+import argparse
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    add_episode_options,
+    add_window_options,
+    chosen_window,
+    cluster,
+    count,
+    episode_config,
+    number,
+    out_folder,
+)
 from drake_biped.experiments.stability import CONDITIONS, condition_window, survives
 from drake_biped.paper import PUSH_DURATION_S
 from drake_biped.params import EpisodeConfig, ParameterError, Push, check_settings
@@ -232,3 +244,39 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
     write_text_atomic(out / "push_margin.md", markdown(record))
     figure(record, out / "push_margin.png")
     return record
+
+
+# The command line: `drake-biped push-margin` (drake_biped/cli.py runs `command`).
+COMMAND = "push-margin"
+PARSER = dict(help="pushes in steady state over a grid of forces and phases of the step, "
+                        "with and without a torque-free period: the survival map and the margins (on Dask)")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped push-margin`'s options."""
+    add_episode_options(p)
+    add_window_options(p)
+    p.add_argument("--max-force", type=number("positive"), default=100.0, help="largest push tried (N); default 100")
+    p.add_argument("--force-step", type=number("positive"), default=5.0,
+                   help="spacing of the force grid (N); default 5")
+    p.add_argument("--phases", type=count, default=12, help="phases of the step pushed; default 12")
+    p.add_argument("--settle", type=number("positive"), default=5.0,
+                   help="the step pushed is the first to start at or after this time (s); default 5")
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    config = episode_config(args)
+    if args.distance is None:  # a push at --settle s (about 6 m), then room to recover or fall
+        config = config.override({"sim.distance_m": 12.0, "sim.max_time_s": max(config.sim.max_time_s, 72.0)})
+    settings = PushMarginSettings(config, chosen_window(args), max_force_n=args.max_force,
+                                              force_step_n=args.force_step, phases=args.phases,
+                                              settle_s=args.settle, force=args.force)
+    out = Path(args.out)
+    with cluster(args) as client:
+        run(settings, out, client)
+    print((out / "push_margin.md").read_text())
+    print(f"wrote {out}/push_margin.json, push_margin.md, push_margin.png")
+    return 0

@@ -31,6 +31,7 @@ reuses every finished experiment and resumes the unfinished one.
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import time
 from collections.abc import Callable
@@ -38,6 +39,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from drake_biped.experiments.options import (
+    add_resumable_run_options,
+    cluster,
+)
 from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import (
     PAPER_CPG,
@@ -128,7 +133,7 @@ class Reproduction:
         """The default gait's learned torque-free period (t1, t2), where it came from, and the learning record
         it came from: the best learned trial of `learn` (the paper's settings), else of `learn_variant`; else the
         window map's cheapest, else LEVEL_WINDOW (no record)."""
-        from drake_biped.experiments.learning import best_learned_trial
+        from drake_biped.experiments.learning_record import best_learned_trial
 
         for source in ("learn", "learn_variant"):
             path = self.out / source / "learning.json"
@@ -553,3 +558,33 @@ def check_out(out: Path, profile: Profile) -> None:
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(marker, profile.to_dict())
 
+
+# The command line: `drake-biped reproduce` (drake_biped/cli.py runs `command`).
+COMMAND = "reproduce"
+PARSER = dict(help="every experiment of the paper and one report beside its numbers "
+                         "(--quick: small settings, minutes)")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped reproduce`'s options."""
+    p.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    from drake_biped.experiments.executor import check_cluster_options
+
+    profile = QUICK if args.quick else FULL
+    out = Path(args.out)
+    check_cluster_options(args.workers, args.scheduler, args.force)  # before the folder is claimed for this profile
+    check_out(out, profile)
+    hours = profile.expected_minutes / 60
+    print(f"reproduce ({profile.name}): {len(steps_of(profile))} experiments into {out}/, expected "
+          "about " + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
+          + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
+    with cluster(args) as client:
+        run(ReproduceSettings(profile), out, client, workers=args.workers,
+                      scheduler=args.scheduler)
+    print("\n".join(line for line in (out / "report.md").read_text().splitlines()[:40] if line.startswith("|")))
+    print(f"wrote {out}/report.md, report.html")
+    return 0

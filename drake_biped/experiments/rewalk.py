@@ -9,16 +9,34 @@ for any learning record. What a saving, a trial's figure and holding mean: `drak
 
 from __future__ import annotations
 
+import argparse
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
 from drake_biped.analysis.rewalks import CHANGES, KEEP, summary
-from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.experiments.learning_record import check_learning_record
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    cluster,
+    out_folder,
+)
+from drake_biped.params import (
+    GRAVITY_MPS2,
+    EpisodeConfig,
+    ParameterError,
+    TorqueFreeWindow,
+    check_settings,
+    config_of_record,
+)
+from drake_biped.records import read_json
+from drake_biped.versions import versions
 
 # A re-walk's length: the initiation's transient, then the long-run mean's span.
 REWALK_M = TRANSIENT_M + LONG_RUN_M
 
-__all__ = ["changed", "rewalk", "window_of"]
+__all__ = ["RewalkSettings", "changed", "rewalk", "rewalk_record", "run", "window_of"]
 
 
 def window_of(sample) -> TorqueFreeWindow:
@@ -70,3 +88,73 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
         for t in learned:
             rows[change].setdefault(t["trial"], rows[change]["no_window"])
     return {**summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows), "distance_m": distance_m}
+
+
+def rewalk_record(source: Path, client) -> dict[str, Any]:
+    """The re-walks of a learning record's final policy means (`source`: a learning.json), with what they
+    were made from."""
+    record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
+    try:
+        config = config_of_record(record["settings"]["config"])
+        learned = [{"trial": int(t["trial"]), "t1": float(t["final_mean"][0]), "t2": float(t["final_mean"][1])}
+                   for t in record["trials"]]
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise ParameterError(f"--policy {source}: a learning record without its final means ({exc})") from None
+    # walked as the record's own re-walks were (a record from before re-walks were long: its episodes' length)
+    before = (record.get("evaluation") or {}).get("rewalks") or {}
+    distance = before.get("distance_m", config.sim.distance_m)
+    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client, distance),
+            "versions": versions()}
+
+
+@dataclass(frozen=True)
+class RewalkSettings:
+    """The learning record (a learning.json) whose final policy means are re-walked."""
+
+    policy: Path
+
+
+def run(settings: RewalkSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """The re-walks of the record's final policy means on `client` (a LocalCluster when None); writes
+    rewalk.json and rewalk.md into `out`. The record."""
+    from drake_biped.analysis.rewalks import markdown
+    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.records import write_atomic, write_text_atomic
+
+    check_settings(settings, RewalkSettings, "rewalk.run")
+    with client_or_local(client) as c:
+        record = rewalk_record(Path(settings.policy), c)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "rewalk.json", record)
+    write_text_atomic(out / "rewalk.md", markdown(record))
+    return record
+
+
+# The command line: `drake-biped rewalk` (drake_biped/cli.py runs `command`).
+COMMAND = "rewalk"
+PARSER = dict(help="a learning run's final policy means re-walked with the plant step halved "
+                        "and from 0.95 and 1.05 x the initiation speed, each against no window under the same "
+                        "change, on Dask")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped rewalk`'s options."""
+    p.add_argument("--policy", required=True, help="the learning.json of drake-biped learn")
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.analysis.rewalks import markdown
+    from drake_biped.records import read_json
+
+    # What is not a learning record is refused before a cluster starts.
+    check_learning_record(read_json(Path(args.policy), "--policy"), f"--policy {args.policy}")
+    out = Path(args.out)
+    with cluster(args) as client:
+        record = run(RewalkSettings(Path(args.policy)), out, client)
+    print(markdown(record))
+    print(f"wrote {out}/rewalk.json, rewalk.md")
+    return 0

@@ -25,6 +25,7 @@ episode, resumed on rerun) and the check episodes are kept in OUT/checks/ and re
 
 from __future__ import annotations
 
+import argparse
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -36,6 +37,16 @@ import numpy as np
 from drake_biped.analysis.rewalks import CHANGE_WORDS, CHANGES
 from drake_biped.analysis.series import moving_average, period
 from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
+from drake_biped.experiments.options import (
+    add_episode_options,
+    add_resumable_run_options,
+    add_window_options,
+    chosen_window,
+    cluster,
+    count,
+    episode_config,
+    number,
+)
 from drake_biped.experiments.rewalk import changed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
@@ -53,10 +64,10 @@ def slope_ground(slope_rad: float, level_length_m: float = 2.0, friction: float 
 
 
 def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The learner state of a level-ground run's best learned trial (`learning.best_learned_trial`), read
+    """The learner state of a level-ground run's best learned trial (`learning_record.best_learned_trial`), read
     from its record OUT/trials/trial_K.json beside the learning.json; and a description of where it came
     from."""
-    from drake_biped.experiments.learning import best_learned_trial
+    from drake_biped.experiments.learning_record import best_learned_trial
     from drake_biped.records import read_json
 
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
@@ -311,3 +322,49 @@ def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
         report.close()
     report.log.update(report.new, finished=True)
     return record
+
+
+# The command line: `drake-biped slope` (drake_biped/cli.py runs `command`).
+COMMAND = "slope"
+PARSER = dict(help="slope adaptation: does the learned torque-free period climb, does none, "
+                        "and does online GARB learning adapt it (Figs. 8-11), on Dask")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped slope`'s options."""
+    add_episode_options(p, slope_command=True)
+    add_window_options(p)
+    p.add_argument("--variance", type=number("positive"), default=0.04,
+                   help="the policy's variance (s^2) when starting from --t1/--t2; default 0.04 as in the paper "
+                   "(--policy carries its own)")
+    p.add_argument("--episodes", type=count, default=100, help="learning episodes per trial (default 100)")
+    p.add_argument("--trials", type=count, default=2, help="independent learning trials (default 2)")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.experiments.progress import check_run_log
+
+    level = args.level_length
+    args.level_length = None  # the slope ground is built by the slope settings, not by the episode options
+    slope_rad, args.slope = args.slope, None
+    config = episode_config(args)
+    slope_ground(slope_rad, level, config.ground.friction)  # refuse a bad slope before anything runs
+    if args.policy is not None:
+        if args.t1 is not None or args.t2 is not None:
+            raise ParameterError("give either --policy or --t1/--t2, not both")
+        settings = SlopeSettings(config, slope_rad, level, policy=str(args.policy), trials=args.trials,
+                                       episodes=args.episodes, seed=config.seed)
+    else:
+        settings = SlopeSettings(config, slope_rad, level, window=chosen_window(args),
+                                       variance=args.variance, trials=args.trials, episodes=args.episodes,
+                                       seed=config.seed)
+    settings.start()  # a --policy that cannot be read is refused before a cluster starts
+    out = Path(args.out)
+    check_run_log(out, "slope")
+    with cluster(args) as client:
+        run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
+    print((out / "report.md").read_text())
+    print(f"wrote {out}/slope.json, report.md, fig8_period.png, fig9_distance.png")
+    return 0

@@ -16,6 +16,7 @@ same settings reads them back and runs only what is missing.
 
 from __future__ import annotations
 
+import argparse
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -25,6 +26,16 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.return_map import complex_list, fit_return_map, least_squares_map
+from drake_biped.experiments.options import (
+    add_episode_options,
+    add_resumable_run_options,
+    add_window_options,
+    chosen_window,
+    cluster,
+    count,
+    episode_config,
+    number,
+)
 from drake_biped.paper import TABLE_VI
 from drake_biped.params import (
     EpisodeConfig,
@@ -352,3 +363,36 @@ def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, clie
                                               "fixed_point_residual")}
         found[condition]["markdown"] = floquet.markdown(f)
     return found
+
+
+# The command line: `drake-biped stability` (drake_biped/cli.py runs `command`).
+COMMAND = "stability"
+PARSER = dict(help="pushes and Poincare return maps with and without a torque-free "
+                          "period (Table VI, Fig. 7), on Dask")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped stability`'s options."""
+    add_episode_options(p)
+    add_window_options(p)
+    p.add_argument("--trials", type=count, default=8, help="trials per cell (default 8)")
+    p.add_argument("--push", type=number("positive"), default=20.0, help="push force (N); default 20")
+    p.add_argument("--floquet", action="store_true",
+                   help="also the periodic orbit's Floquet multipliers without and with the window (about a "
+                   "minute each on 2 cores), in the report beside the regression")
+    p.add_argument("--spread", type=number("nonnegative"), default=0.15,
+                   help="trials' initial hip angle and speed within +-this fraction (default 0.15)")
+    add_resumable_run_options(p)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    config = episode_config(args)
+    settings = StabilitySettings(window=chosen_window(args), trials=args.trials,
+                                           push_force_n=args.push, spread=args.spread, seed=config.seed)
+    out = Path(args.out)
+    with cluster(args) as client:
+        run(settings, out, client, config=config, floquet=args.floquet)
+    print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
+    print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
+    return 0

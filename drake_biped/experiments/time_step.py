@@ -14,6 +14,7 @@ C_mt, for every walk that walks at the finest step, is within TOLERANCE of it (a
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -24,6 +25,16 @@ from pathlib import Path
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    add_model_option,
+    cluster,
+    number,
+    out_folder,
+    steps,
+    windows,
+    with_model,
+)
 from drake_biped.params import (
     GRAVITY_MPS2,
     EpisodeConfig,
@@ -334,3 +345,52 @@ def replot(out: Path) -> dict:
     write_text_atomic(out / "time_step_study.md", markdown(rec))
     figure(rec, out / "time_step_study.png")
     return rec
+
+
+# The command line: `drake-biped time-step-study` (drake_biped/cli.py runs `command`).
+COMMAND = "time-step-study"
+PARSER = dict(help="the long-run C_mt against the plant step (control period kept), "
+                        "Richardson's limit, and the step they choose")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped time-step-study`'s options."""
+    p.add_argument("--steps", type=steps, default=list(STEPS),
+                   help="plant steps (s), comma-separated (default 0.002,0.001,0.0005,0.00025,0.000125)")
+    p.add_argument("--reference", type=number("positive"), default=None,
+                   help="reference step (s), one of --steps (default: the finest)")
+    p.add_argument("--distance", type=number("positive"), default=LONG_WALK_M,
+                   help="walk this far (m); default 110: the first 10 m are the transient, the long-run C_mt is "
+                   "over the rest")
+    p.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
+                   "default gait. Its own time step is replaced by each of --steps")
+    add_model_option(p)
+    p.add_argument("--windows", type=windows,
+                   help="the windows compared with none, T1-T2 in s, comma-separated (default "
+                   "0.405096-0.944455,0.3-0.6: the default gait's learned window and one early in the swing)")
+    add_cluster_options(p)
+    p.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
+    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    out = Path(args.out)
+    if args.replot:
+        rec = replot(out)
+    else:
+        from drake_biped.resources import load_gait
+
+        config = None if args.params is None else load_gait(args.params)
+        if args.model is not None:
+            config = with_model(config or EpisodeConfig(), args.model)
+        reference = min(args.steps) if args.reference is None else args.reference
+        settings = TimeStepSettings(tuple(args.steps), reference, args.distance, config,
+                                              "Default gait" if args.params is None else f"Gait {args.params}",
+                                              None if args.windows is None else tuple(args.windows))
+        with cluster(args) as client:
+            rec = run(settings, out, client)
+    print((out / "time_step_study.md").read_text())
+    chosen = rec["chosen_step_s"]
+    print(f"chosen step: {chosen * 1e3:g} ms" if chosen else "no step passes", f"; wrote {out}/")
+    return 0

@@ -3,9 +3,11 @@ recording, the walk figure and GIF (`run` writes them all; `drake-biped walk` is
 
 from __future__ import annotations
 
+import argparse
 import logging
 import shutil
 import subprocess
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -13,7 +15,14 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
-from drake_biped.params import EpisodeConfig, check_settings
+from drake_biped.experiments.options import (
+    add_episode_options,
+    episode_config,
+    number,
+    out_folder,
+    print_lines,
+)
+from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow, check_settings
 from drake_biped.records import warn, write_text_atomic
 
 
@@ -201,3 +210,50 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
         walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height,
                        body=body_of_model(config.model))
     return result
+
+
+# The command line: `drake-biped walk` (drake_biped/cli.py runs `command`).
+COMMAND = "walk"
+PARSER = dict(help="walk one episode and write its record, figures and animation")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped walk`'s options."""
+    add_episode_options(p)
+    p.add_argument("--t1", type=number("nonnegative"),
+                   help="torque-free start after each step start (s); with --t2 (default: no window)")
+    p.add_argument("--t2", type=number("nonnegative"), help="torque-free end (s), after --t1 (default: no window)")
+    p.add_argument("--push", type=number("finite"), help="horizontal push on the torso (N, + forward) "
+                   "(default: none)")
+    p.add_argument("--push-start", type=number("nonnegative"), default=0.4, help="push start (s)")
+    p.add_argument("--push-duration", type=number("positive"), default=0.1, help="push duration (s)")
+    p.add_argument("--save-trajectory", action="store_true", help="also write trajectory.npz")
+    p.add_argument("--no-animation", action="store_true", help="skip walk.html and walk.gif")
+    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    config = episode_config(args)
+    if (args.t1 is None) != (args.t2 is None):
+        raise ParameterError("--t1 and --t2 go together: give both or neither")
+    if args.t1 is not None:
+        if args.t2 <= args.t1:
+            raise ParameterError(f"--t1 {args.t1:g} --t2 {args.t2:g}: t2 <= t1 is no torque-free window; "
+                                 "give t1 < t2, or neither to walk without one")
+        config = config.replace(window=TorqueFreeWindow(args.t1, args.t2))
+    if args.push is not None:
+        config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
+    elif args.push_start != 0.4 or args.push_duration != 0.1:
+        raise ParameterError("--push-start and --push-duration shape a push: give --push N too")
+    out = Path(args.out)
+    result = run(WalkSettings(config, animation=not args.no_animation,
+                                        save_trajectory=args.save_trajectory), out)
+    print_lines(summary_lines(result))
+    if not args.no_animation:
+        print_lines(animation_lines(out))
+    if config.push is not None and result.duration_s <= config.push.start_s:
+        print(f"note: the episode ended at {result.duration_s:.2f} s, before the push at {config.push.start_s:g} s "
+              "started: it walked unpushed", file=sys.stderr)
+    print(f"wrote {out}/")
+    return 0

@@ -5,6 +5,7 @@ EpisodeConfig (numbers only) and builds its own diagram.
 
 from __future__ import annotations
 
+import argparse
 import csv
 import io
 import json
@@ -16,6 +17,15 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.series import signed_percent
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    add_episode_options,
+    cluster,
+    episode_config,
+    number,
+    out_folder,
+    print_lines,
+)
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
@@ -192,3 +202,29 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
         lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
                      f"({signed_percent(best['cmt_change'])} vs no window)")
     return lines
+
+
+# The command line: `drake-biped window-map` (drake_biped/cli.py runs `command`).
+COMMAND = "window-map"
+PARSER = dict(help="C_mt of a grid of torque-free windows against no window")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped window-map`'s options."""
+    add_episode_options(p)
+    p.add_argument("--step", type=number("positive"), default=0.1, help="grid spacing of t1 and t2 (s)")
+    p.add_argument("--t1-max", type=number("nonnegative"), default=0.6, help="largest start t1 (s)")
+    p.add_argument("--t2-max", type=number("positive"), default=0.9, help="largest end t2 (s)")
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = WindowMapSettings(episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
+                                            t1_step_s=args.step, t2_step_s=args.step, force=args.force)
+    with cluster(args) as client:
+        record = run(settings, Path(args.out), client)
+    print_lines(summary_lines(record))
+    print(f"wrote {args.out}/window_map.json, window_map.csv, window_map.png")
+    return 0
