@@ -355,11 +355,11 @@ class Reproduction:
 
         p = self.profile
         window, source, _ = self.learned_window()
-        settings = stability.StabilitySettings(window=window, trials=p.stability_trials)
+        settings = stability.StabilitySettings(window=window, trials=p.stability_trials, config=self.level,
+                                               jacobian_kicks=stability.JACOBIAN_KICKS_RAD if p.jacobian else ())
 
         def run(folder: Path) -> dict:
-            record = stability.run(settings, folder, self._client, progress=False, config=self.level,
-                                   jacobian_kicks=stability.JACOBIAN_KICKS_RAD if p.jacobian else ())
+            record = stability.run(settings, folder, self._client, progress=False)
             return {"cells": _cells(record), "window_source": source}
 
         return self.experiment("stability", {**settings.to_dict(), "jacobian": p.jacobian,

@@ -53,6 +53,9 @@ DISTURBANCES = ("undisturbed", "forward", "backward")
 TABLE_VI_PAPER = TABLE_VI  # eigenvalues of the return map, as (real, imaginary) pairs
 
 
+JACOBIAN_KICKS_RAD = (0.005, 0.01, 0.02)  # swing-hip angle kicks; rate kicks are 10x (rad/s)
+
+
 @dataclass(frozen=True)
 class StabilitySettings:
     """What a stability run depends on besides the episode configuration."""
@@ -66,6 +69,12 @@ class StabilitySettings:
     steady_from_step: int = 6
     bootstrap: int = 1000
     seed: int = 0
+    # The gait (None: the default one), the finite-difference Jacobian's kicks (empty: none) and whether the
+    # periodic orbit's Floquet multipliers are added to the report: how the run is made, kept out of to_dict
+    # (the record holds the configuration itself).
+    config: EpisodeConfig | None = None
+    jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD
+    floquet: bool = False
 
     def __post_init__(self) -> None:
         t1, t2 = self.window
@@ -85,6 +94,8 @@ class StabilitySettings:
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
+        for name in ("config", "jacobian_kicks", "floquet"):
+            d.pop(name)
         d["window"] = list(self.window)
         return d
 
@@ -185,7 +196,6 @@ def _result_path(out: Path, condition: str, kind: str, trial: int) -> Path:
     return out / "episodes" / f"{condition}_{kind}_{trial}.json"
 
 
-JACOBIAN_KICKS_RAD = (0.005, 0.01, 0.02)  # swing-hip angle kicks; rate kicks are 10x (rad/s)
 
 
 def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, client,
@@ -312,20 +322,19 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle
     }
 
 
-def run(settings: StabilitySettings, out: Path, client=None, progress: bool = True, config: EpisodeConfig | None = None,
-        jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD, floquet: bool = False) -> dict[str, Any]:
-    """The six cells and the Jacobians of `config`'s gait (the default gait when None) on `client` (a
+def run(settings: StabilitySettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """The six cells and the Jacobians of the settings' gait (the default gait when None) on `client` (a
     LocalCluster when None), with a progress bar; writes episodes/, stability.json, fig7_return_map.png,
-    report.md and report.html into `out`. `floquet`: also the periodic orbit's Floquet multipliers without
-    and with the window (experiments/floquet.py; floquet_without/, floquet_with/ and a report section). The
-    record."""
+    report.md and report.html into `out`. `settings.floquet`: also the periodic orbit's Floquet multipliers
+    without and with the window (experiments/floquet.py; floquet_without/, floquet_with/ and a report
+    section). The record."""
     check_settings(settings, StabilitySettings, "stability.run")
     from drake_biped.analysis.stability_report import write_stability_outputs
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.records import write_atomic
 
     out = Path(out)
-    config = config or EpisodeConfig()
+    config = settings.config or EpisodeConfig()
     bar = None
     if progress:
         from tqdm import tqdm
@@ -339,8 +348,8 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     try:
         with client_or_local(client) as c:
             record = run_stability(out, config, settings, c, report if bar is not None else None,
-                                   jacobian_kicks=jacobian_kicks)
-            if floquet:
+                                   jacobian_kicks=settings.jacobian_kicks)
+            if settings.floquet:
                 record["floquet"] = _floquet(config, settings.window, out, c)
     finally:
         if bar is not None:
@@ -388,11 +397,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     config = episode_config(args)
-    settings = StabilitySettings(window=chosen_window(args), trials=args.trials,
-                                           push_force_n=args.push, spread=args.spread, seed=config.seed)
+    settings = StabilitySettings(window=chosen_window(args), trials=args.trials, push_force_n=args.push,
+                                 spread=args.spread, seed=config.seed, config=config, floquet=args.floquet)
     out = Path(args.out)
     with cluster(args) as client:
-        run(settings, out, client, config=config, floquet=args.floquet)
+        run(settings, out, client)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
     print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
     return 0
