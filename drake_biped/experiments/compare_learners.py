@@ -181,8 +181,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="the gait's window map (a window-map folder or its window_map.json): the known optimum")
     p.add_argument("--learners", type=learner_names, default=["garb", "cmaes", "pgpe"],
                    help="comma-separated (default garb,cmaes,pgpe)")
-    p.add_argument("--trials", type=count, default=5, help="trials per learner (default 5)")
-    p.add_argument("--episodes", type=count, default=300, help="episodes per trial (default 300)")
+    p.add_argument("--trials", type=count, default=5, help="trials per learner")
+    p.add_argument("--episodes", type=count, default=300, help="episodes per trial")
     add_resumable_run_options(p)
 
 

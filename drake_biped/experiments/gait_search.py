@@ -710,9 +710,9 @@ PARSER = dict(help="evolve gait parameters for walking and torque-free savings",
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped gait-search`'s options."""
     add_episode_options(p)
-    p.add_argument("--generations", type=count, default=50, help="generations (default 50)")
-    p.add_argument("--offspring", type=count, default=4, help="children per generation (default 4)")
-    p.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale (default 0.1)")
+    p.add_argument("--generations", type=count, default=50, help="generations")
+    p.add_argument("--offspring", type=count, default=4, help="children per generation")
+    p.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale")
     p.add_argument("--mutations", choices=["default", "paper", "near_paper", "coast"], default="default",
                    help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
                    "the paper does not print: the CPG and the initiation held), 'near_paper' (those "

@@ -87,8 +87,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="policy variances (s^2), comma-separated; default 0.04,0.01,0.0025")
     p.add_argument("--start", type=number("nonnegative"), nargs=2, metavar=("T1", "T2"),
                    help="a policy start to evaluate (default 0.5 0.5)")
-    p.add_argument("--samples", type=count, default=2000, help="Monte Carlo samples per mean (default 2000)")
-    p.add_argument("--seed", type=seed_type, default=0, help="random seed (default 0)")
+    p.add_argument("--samples", type=count, default=2000, help="Monte Carlo samples per mean")
+    p.add_argument("--seed", type=seed_type, default=0, help="random seed")
     p.add_argument("--out", default=None, type=out_folder, help="output folder (default: the window map's)")
 
 

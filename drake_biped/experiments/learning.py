@@ -497,8 +497,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("--learner", choices=sorted(LEARNERS), default="garb",
                    help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
-    p.add_argument("--trials", type=count, default=5, help="independent trials (default 5)")
-    p.add_argument("--episodes", type=count, default=500, help="episodes per trial (default 500)")
+    p.add_argument("--trials", type=count, default=5, help="independent trials")
+    p.add_argument("--episodes", type=count, default=500, help="episodes per trial")
     p.add_argument("--initial-mean", type=number("nonnegative"), nargs=2, default=[0.5, 0.5],
                    metavar=("T1", "T2"), help="the policy's starting mean (s); default 0.5 0.5 as in the paper")
     p.add_argument("--variance", type=number("positive"), default=0.04,

@@ -256,10 +256,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped push-margin`'s options."""
     add_episode_options(p)
     add_window_options(p)
-    p.add_argument("--max-force", type=number("positive"), default=100.0, help="largest push tried (N); default 100")
+    p.add_argument("--max-force", type=number("positive"), default=100.0, help="largest push tried (N)")
     p.add_argument("--force-step", type=number("positive"), default=5.0,
                    help="spacing of the force grid (N); default 5")
-    p.add_argument("--phases", type=count, default=12, help="phases of the step pushed; default 12")
+    p.add_argument("--phases", type=count, default=12, help="phases of the step pushed")
     p.add_argument("--settle", type=number("positive"), default=5.0,
                    help="the step pushed is the first to start at or after this time (s); default 5")
     add_cluster_options(p)

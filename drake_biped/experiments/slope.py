@@ -337,8 +337,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--variance", type=number("positive"), default=0.04,
                    help="the policy's variance (s^2) when starting from --t1/--t2; default 0.04 as in the paper "
                    "(--policy carries its own)")
-    p.add_argument("--episodes", type=count, default=100, help="learning episodes per trial (default 100)")
-    p.add_argument("--trials", type=count, default=2, help="independent learning trials (default 2)")
+    p.add_argument("--episodes", type=count, default=100, help="learning episodes per trial")
+    p.add_argument("--trials", type=count, default=2, help="independent learning trials")
     add_resumable_run_options(p)
 
 

@@ -384,8 +384,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped stability`'s options."""
     add_episode_options(p)
     add_window_options(p)
-    p.add_argument("--trials", type=count, default=8, help="trials per cell (default 8)")
-    p.add_argument("--push", type=number("positive"), default=20.0, help="push force (N); default 20")
+    p.add_argument("--trials", type=count, default=8, help="trials per cell")
+    p.add_argument("--push", type=number("positive"), default=20.0, help="push force (N)")
     p.add_argument("--floquet", action="store_true",
                    help="also the periodic orbit's Floquet multipliers without and with the window (about a "
                    "minute each on 2 cores), in the report beside the regression")
