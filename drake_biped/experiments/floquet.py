@@ -307,7 +307,7 @@ def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
 # The command line: `drake-biped floquet` (drake_biped/cli.py runs `command`).
 COMMAND = "floquet"
 PARSER = dict(help="the gait's periodic orbit (Newton on the full-state step map) and its "
-                        "Floquet multipliers by central differences through Drake, on Dask")
+              "Floquet multipliers by central differences through Drake, on Dask")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

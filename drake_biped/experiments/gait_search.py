@@ -704,7 +704,7 @@ def _append(path: Path, record: dict) -> None:
 # The command line: `drake-biped gait-search` (drake_biped/cli.py runs `command`).
 COMMAND = "gait-search"
 PARSER = dict(help="evolve gait parameters for walking and torque-free savings",
-                            epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
+              epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -249,7 +249,7 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
 # The command line: `drake-biped push-margin` (drake_biped/cli.py runs `command`).
 COMMAND = "push-margin"
 PARSER = dict(help="pushes in steady state over a grid of forces and phases of the step, "
-                        "with and without a torque-free period: the survival map and the margins (on Dask)")
+              "with and without a torque-free period: the survival map and the margins (on Dask)")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -562,7 +562,7 @@ def check_out(out: Path, profile: Profile) -> None:
 # The command line: `drake-biped reproduce` (drake_biped/cli.py runs `command`).
 COMMAND = "reproduce"
 PARSER = dict(help="every experiment of the paper and one report beside its numbers "
-                         "(--quick: small settings, minutes)")
+              "(--quick: small settings, minutes)")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

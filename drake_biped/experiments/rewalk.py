@@ -134,8 +134,8 @@ def run(settings: RewalkSettings, out: Path, client=None, progress: bool = True)
 # The command line: `drake-biped rewalk` (drake_biped/cli.py runs `command`).
 COMMAND = "rewalk"
 PARSER = dict(help="a learning run's final policy means re-walked with the plant step halved "
-                        "and from 0.95 and 1.05 x the initiation speed, each against no window under the same "
-                        "change, on Dask")
+              "and from 0.95 and 1.05 x the initiation speed, each against no window under the same "
+              "change, on Dask")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -377,7 +377,7 @@ def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, clie
 # The command line: `drake-biped stability` (drake_biped/cli.py runs `command`).
 COMMAND = "stability"
 PARSER = dict(help="pushes and Poincare return maps with and without a torque-free "
-                          "period (Table VI, Fig. 7), on Dask")
+              "period (Table VI, Fig. 7), on Dask")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

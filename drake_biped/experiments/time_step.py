@@ -350,7 +350,7 @@ def replot(out: Path) -> dict:
 # The command line: `drake-biped time-step-study` (drake_biped/cli.py runs `command`).
 COMMAND = "time-step-study"
 PARSER = dict(help="the long-run C_mt against the plant step (control period kept), "
-                        "Richardson's limit, and the step they choose")
+              "Richardson's limit, and the step they choose")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
