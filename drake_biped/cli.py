@@ -16,28 +16,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from drake_biped.experiments.options import (  # noqa: F401  (number, integer, windows: the examples' option types)
-    MADE,
-    add_cluster_options,
-    add_episode_options,
-    add_model_option,
-    add_resumable_run_options,
-    add_window_options,
-    chosen_window,
-    cluster,
-    count,
-    episode_config,
-    integer,
-    learner_names,
-    number,
-    out_folder,
-    positive_list,
-    print_lines,
-    seed_type,
-    steps,
-    windows,
-    with_model,
-)
+# MADE: the folders --out made; integer, number, windows: the option types the examples give their own parsers.
+from drake_biped.experiments.options import MADE, integer, number, windows  # noqa: F401
 from drake_biped.model import ModelError
 from drake_biped.params import ParameterError
 

@@ -614,7 +614,7 @@ def test_a_time_step_above_the_converged_range_warns_and_a_diverging_walk_says_s
     err = capsys.readouterr()
     assert code == 0
     assert [line for line in err.err.splitlines() if line.startswith("warning:")] == [
-        "warning: --time-step 0.01 is above 2 ms, beyond the steps at which the default gait's walk converges "
+        "warning: --time-step 0.01 is above 1 ms, beyond the steps at which the default gait's walk converges "
         "(docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its control loop diverges, which ends an episode as 'diverged'"]
     assert err.out.startswith("DIVERGED (the control loop diverged")
     record = json.loads((tmp_path / "w" / "result.json").read_text())
