@@ -2,8 +2,8 @@
 largest Lyapunov exponent of a step map, the rate at which nearby walks part.
 
 A walk is read at its touchdowns. Its step periods after the transient tell the attractor: period-k where the
-last `window` periods repeat with period k (k <= MAX_PERIOD) to within `tolerance_s` (the same k-th neighbour,
-step after step), else irregular. The Lyapunov exponent (per step) comes either from the Jacobians of the step
+last periods repeat with period k (k <= MAX_PERIOD): every k-th one within `tolerance_s` of the others,
+else irregular. The Lyapunov exponent (per step) comes either from the Jacobians of the step
 map along the walk (Benettin's method: a tangent vector carried by the product of the Jacobians, renormalised
 every step) or from two walks that start a small distance apart (the mean logarithmic rate at which their
 sections part, before they saturate).
@@ -26,18 +26,18 @@ def step_period_label(periods_s: Sequence[float], fell: bool = False, window: in
                       tolerance_s: float = PERIOD_TOLERANCE_S, max_period: int = MAX_PERIOD) -> dict:
     """The attractor a walk's step periods show: {"attractor": "fell" | "period-k" | "irregular" |
     "too short", "period": k or None, "spread_s": the last `window` periods' max - min}. Period-k: the smallest
-    k with |T_j - T_(j-k)| < tolerance_s for every j among the last `window` steps (period-1: the last
-    `window` periods vary by less than tolerance_s)."""
+    k for which, among the last max(window, 3 k) periods, every k-th one (T_j, T_(j+k), T_(j+2k), ...) varies
+    by less than tolerance_s (period-1: the last `window` periods vary by less than tolerance_s)."""
     t = np.asarray(periods_s, dtype=float)
     if fell:
         return {"attractor": "fell", "period": None, "spread_s": None}
-    if t.ndim != 1 or len(t) < window + max_period:
+    if t.ndim != 1 or len(t) < max(window, 3 * max_period):
         return {"attractor": "too short", "period": None, "spread_s": None}
     last = t[-window:]
     spread = float(last.max() - last.min())
     for k in range(1, max_period + 1):
-        tail = t[-(window + k):]
-        if np.all(np.abs(tail[k:] - tail[:-k]) < tolerance_s):
+        tail = t[-max(window, 3 * k):]
+        if all(np.ptp(tail[r::k]) < tolerance_s for r in range(k)):
             return {"attractor": f"period-{k}", "period": k, "spread_s": spread}
     return {"attractor": "irregular", "period": None, "spread_s": spread}
 

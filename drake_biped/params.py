@@ -635,6 +635,7 @@ SHORT_NAMES = {
     "speed": "initial.speed_mps",
     "t1": "window.start_s",
     "t2": "window.end_s",
+    "slope": "ground.slope_rad",
 }
 
 

@@ -33,6 +33,9 @@ def test_step_periods_that_do_not_repeat_are_irregular_and_a_fall_is_a_fall():
     steady = np.full(40, 0.426)
     steady[-7] += 0.0025
     assert step_period_label(steady)["attractor"] != "period-1"
+    drifting = 0.426 + 0.00015 * np.arange(40)  # each step within 2 ms of the last, the last 20 spread 2.85 ms
+    assert step_period_label(drifting)["attractor"] != "period-1"
+    assert step_period_label(drifting[:-14], window=6)["attractor"] == "period-1"
 
 
 def _logistic_orbit(r, x0, n):

@@ -227,12 +227,13 @@ def episode_task(config: dict[str, Any], kick: dict[str, float] | None = None) -
 
 def run_kept(
     client: Any,
-    jobs: dict[Any, tuple[Any, dict[str, Any]]],
+    jobs: dict[Any, tuple[Any, ...]],
     progress: Callable[[int, int], None] | None = None,
 ) -> dict[Any, dict[str, Any]]:
-    """One episode per job {key: (path, EpisodeConfig dict)}, each result kept at its path (atomically):
-    a result already there for the same configuration is read back instead of run. Results by key;
-    progress(done, total) as they come."""
+    """One episode per job {key: (path, EpisodeConfig dict)} or {key: (path, config dict, kick)} (a kick: the
+    fields of drake_biped.episode.Kick), each result kept at its path (atomically): a result already there for
+    the same configuration and kick is read back instead of run. Results by key; progress(done, total) as they
+    come."""
 
     from distributed import as_completed
 
@@ -240,21 +241,24 @@ def run_kept(
 
     results: dict[Any, dict[str, Any]] = {}
     todo = {}
-    for key, (path, config) in jobs.items():
+    for key, (path, config, *rest) in jobs.items():
+        kick = rest[0] if rest else None
         saved = read_kept(path)
         if isinstance(saved, dict):
-            if saved.get("config") == config:
+            if saved.get("config") == config and saved.get("kick") == kick:
                 results[key] = saved
                 continue
-        todo[key] = (path, config)
+        todo[key] = (path, config, kick)
     if progress:
         progress(len(results), len(jobs))
-    futures = {client.submit(episode_task, config, pure=False): key for key, (_, config) in todo.items()}
+    futures = {client.submit(episode_task, config, kick, pure=False): key for key, (_, config, kick) in todo.items()}
     for future in as_completed(list(futures)):
         key = futures[future]
         r = future.result()
         r.pop("task_wall_time_s", None)
         r.pop("worker_peak_rss_mb", None)
+        if todo[key][2] is not None:
+            r["kick"] = todo[key][2]
         todo[key][0].parent.mkdir(parents=True, exist_ok=True)
         write_atomic(todo[key][0], r)
         results[key] = r

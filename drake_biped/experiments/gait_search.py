@@ -124,6 +124,13 @@ HOLD_BAND = (0.36, 0.48)
 # held in one walk and not in the next).
 HOLD_LONG_WINDOWS = ((0.36, 1.2), (0.40, 1.2), (0.44, 1.2), (0.48, 1.2))
 HOLD_LONG_M = 40.0
+# The "hold-step" objective: windows placed by the gait's own powered step period T (its long walk without a
+# window): below it, t1 = T - HOLD_STEP_BELOW_S judged long-run like "hold-long"; past it, t1 = T +
+# HOLD_STEP_PAST_S judged by the learner's own 10 m episode from the initiation, whose saving there is what
+# draws GARB's means past the step's end (the initiation's first steps run longer than the steady ones, so a
+# window that never acts in the steady gait still acts, and saves, in a 10 m episode).
+HOLD_STEP_BELOW_S = (0.08, 0.04, 0.015)
+HOLD_STEP_PAST_S = (0.015, 0.04)
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -362,6 +369,34 @@ def _hold_long_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                    "distance_from_table_iii": d}
 
 
+def _hold_step_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-step" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    robust, detail = _robust_score(config, base)
+    if robust < 0.0:
+        return robust - 2.0, detail
+    changed = {"as_is": config, **_changed(config)}
+    bases = {name: _long_walk(c.replace(window=TorqueFreeWindow())) for name, c in changed.items()}
+    if not all(b["walked"] for b in bases.values()):
+        walked = sum(b["walked"] for b in bases.values())
+        return -1.5 + 0.1 * walked, {**detail, "long_bases": bases}
+    period = bases["as_is"]["step_period_s"]
+    windows = []
+    for below in HOLD_STEP_BELOW_S:
+        t1 = round(period - below, 4)
+        walks = {name: _long_walk(c.replace(window=TorqueFreeWindow(t1, 1.2))) for name, c in changed.items()}
+        windows.append({"window": [t1, 1.2], "walks": walks,
+                        "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
+    savings = [v for w in windows for v in w["savings"].values()]
+    past = [{"window": [round(period + s, 4), 1.2],
+             **_walk(config.replace(window=TorqueFreeWindow(round(period + s, 4), 1.2)))} for s in HOLD_STEP_PAST_S]
+    lure = max([0.0, *(_saving(row, base) for row in past if row["walked"])])
+    least = min(savings)
+    d = distance_from_table_iii(config.cpg)
+    value = least - lure + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
+    return value, {**detail, "long_bases": bases, "windows": windows, "past_step": past, "least_saving": least,
+                   "past_step_saving": lure, "step_period_s": period, "distance_from_table_iii": d}
+
+
 Score = Callable[[EpisodeConfig, dict[str, Any], Any, int], tuple[float, dict[str, Any]]]
 
 
@@ -436,6 +471,10 @@ def _hold_long_objective(config, base, windows, draws):
     return _hold_long_score(config, base)
 
 
+def _hold_step_objective(config, base, windows, draws):
+    return _hold_step_score(config, base)
+
+
 # Every objective a search can score by: its function and what it scores (the module docstring, the command's
 # help and the search's records read the names and the texts from here).
 OBJECTIVES: dict[str, Objective] = {
@@ -451,6 +490,7 @@ OBJECTIVES: dict[str, Objective] = {
     "story": Objective(_story_objective, True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
     "hold": Objective(_hold_objective, True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
     "hold-long": Objective(_hold_long_objective, True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
+    "hold-step": Objective(_hold_step_objective, True, 'The "robust" objective first, then windows placed by the gait\'s own powered step period T (its long walk without a window): t1 = T - HOLD_STEP_BELOW_S (the hip off until the foot lands) judged as in "hold-long", minus the largest saving of a 10 m episode from the initiation with t1 = T + HOLD_STEP_PAST_S (a window that saves there only while the initiation\'s long first steps last draws GARB past the step\'s end): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
 }
 
 

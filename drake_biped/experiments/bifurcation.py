@@ -1,0 +1,353 @@
+"""What the gait settles on as one parameter changes: a bifurcation diagram (`drake-biped bifurcation`).
+
+For each value of the parameter (a window's t1 or t2, the slope, the initiation, any EpisodeConfig field), one
+long walk: the steps within `transient_m` of the first touchdown are dropped, and the step periods and section
+states (hip angle and rate at touchdown) of the rest are kept and read by `analysis.attractor`: period-k where
+every k-th of the last step periods varies by less than 2 ms, irregular, or a fall. Garcia et al. (1998) drew
+the simplest walker's period doubling this way.
+
+The 1 kHz controller sees a touchdown only at its next update, so even a regular gait's step periods jitter by a
+few milliseconds (the full-state section map is discontinuous on that scale, which leaves Newton's method and
+central-difference multipliers without a meaning there). Each point is therefore also read at the jitter's
+scale (period-k to within `jitter_tolerance_s`), and an irregular walk gets a finite-size Lyapunov exponent: a
+neighbour walk, its swing hip's rate kicked by NEIGHBOUR_KICK_RADPS early in the first step after the
+transient, and the rate at which their sections part (`attractor.lyapunov_from_neighbours`) until they are half
+the attractor's size apart. A second plant step may be given to show what the discretisation does. Walks are
+kept in `walks/` as each finishes: a rerun of the same command resumes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.analysis.attractor import (
+    MAX_PERIOD,
+    PERIOD_TOLERANCE_S,
+    PERIOD_WINDOW,
+    lyapunov_from_neighbours,
+    step_period_label,
+)
+from drake_biped.analysis.long_run import TRANSIENT_M, long_run_cost
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    add_episode_options,
+    count,
+    episode_config,
+    number,
+    out_folder,
+)
+from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, check_settings, resolve_field
+from drake_biped.records import save_figure, write_atomic, write_text_atomic
+from drake_biped.versions import versions
+
+__all__ = ["BifurcationSettings", "attractor_of_walk", "run", "markdown"]
+
+# At most this many walks without --force.
+MAX_WALKS = 400
+# The step periods of a regular gait jitter by a few ms (the controller sees a touchdown at its next update):
+# the tolerance of the reading at that scale.
+JITTER_TOLERANCE_S = 0.01
+# The neighbour walk of an irregular one: its swing hip's rate kicked by this much (rad/s), this long after the
+# first kept touchdown (the swing foot in the air); their sections' distance followed until it reaches this
+# fraction of the attractor's spread.
+NEIGHBOUR_KICK_RADPS = 0.05
+KICK_AFTER_TOUCHDOWN_S = 0.1
+LYAPUNOV_SATURATION = 0.5
+
+
+@dataclass(frozen=True)
+class BifurcationSettings:
+    """The gait (its window, slope and plant step), the parameter and its values, an optional second plant
+    step, the transient dropped, the jitter's tolerance and whether irregular walks get a neighbour."""
+
+    config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 60.0,
+                                                                                    "sim.max_time_s": 360.0}))
+    param: str = "t1"
+    values: tuple[float, ...] = (0.30, 0.38, 0.46)
+    second_time_step_s: float | None = None
+    transient_m: float = TRANSIENT_M
+    jitter_tolerance_s: float = JITTER_TOLERANCE_S
+    lyapunov: bool = True
+    force: bool = False
+
+    def __post_init__(self) -> None:
+        resolve_field(self.param)  # ParameterError naming an unknown parameter
+        if not self.values or any(not (isinstance(v, (int, float)) and math.isfinite(v)) for v in self.values):
+            raise ParameterError(f"bifurcation: values must be finite numbers, got {self.values!r}")
+        if self.second_time_step_s is not None and not (math.isfinite(self.second_time_step_s)
+                                                        and self.second_time_step_s > 0):
+            raise ParameterError(f"--second-time-step must be positive, got {self.second_time_step_s!r}")
+        if not (math.isfinite(self.transient_m) and 0 <= self.transient_m < self.config.sim.distance_m):
+            raise ParameterError(f"--transient {self.transient_m:g} m must lie below --distance "
+                                 f"{self.config.sim.distance_m:g} m")
+        if self.walks > MAX_WALKS and not self.force:
+            raise ParameterError(f"bifurcation: {self.walks} walks is above {MAX_WALKS}; lower --num, or give --force")
+
+    @property
+    def time_steps(self) -> tuple[float, ...]:
+        first = self.config.sim.time_step_s
+        return (first,) if self.second_time_step_s is None else (first, self.second_time_step_s)
+
+    @property
+    def walks(self) -> int:
+        return len(self.values) * len(self.time_steps) * (2 if self.lyapunov else 1)
+
+
+def point_config(settings: BifurcationSettings, value: float, time_step_s: float) -> EpisodeConfig:
+    """The walk of one point: the settings' gait with the parameter at `value`, at plant step `time_step_s`
+    (the control period kept, as everywhere)."""
+    from drake_biped.params import with_time_step
+
+    config = settings.config.override({settings.param: float(value)})
+    if time_step_s != config.sim.time_step_s:
+        sim = with_time_step(config.sim, time_step_s, "--second-time-step")
+        config = config.override({"sim.time_step_s": sim.time_step_s, "sim.control_period_s": sim.control_period_s})
+    return config
+
+
+def attractor_of_walk(result: dict[str, Any], distance_m: float, transient_m: float = TRANSIENT_M,
+                      window: int = PERIOD_WINDOW, tolerance_s: float = PERIOD_TOLERANCE_S) -> dict[str, Any]:
+    """What a walk (an episode's result dictionary) settled on: its steps after the transient (step periods,
+    section states), the attractor they show (analysis.attractor.step_period_label: "period-k", "irregular",
+    "fell", or "too short" when the walk kept too few steps), and its long-run C_mt with the 95 % interval."""
+    steps = result["steps"]
+    times = np.array([s["touchdown_time_s"] for s in steps], dtype=float)
+    com = np.array([s["com_x_m"] for s in steps], dtype=float)
+    work = np.array([math.nan if s["positive_work_j"] is None else s["positive_work_j"] for s in steps], dtype=float)
+    fell = bool(result["fell"]) or result["distance_m"] < distance_m - 1e-6
+    first = int(np.searchsorted(com - com[0], transient_m, side="left")) if len(com) else 0
+    periods = np.diff(times[first:])
+    sections = [[s["hip_angle_rad"], s["hip_rate_radps"]] for s in steps[first + 1:]]
+    label = step_period_label(periods, fell=fell, window=window, tolerance_s=tolerance_s)
+    long_run = long_run_cost(times, com, work, result["mass_kg"], GRAVITY_MPS2, transient_m) if not fell else None
+    return {"fell": fell, "fall_reason": result.get("fall_reason") or None, "distance_m": result["distance_m"],
+            "first_kept_step": first, "step_periods_s": [float(t) for t in periods], "sections": sections,
+            **label,
+            "cost_of_transport": None if long_run is None else long_run["cost_of_transport"],
+            "interval_95": None if long_run is None else long_run["interval_95"]}
+
+
+def _walk_path(out: Path, i: int, time_step_s: float, neighbour: bool = False) -> Path:
+    return out / "walks" / f"{i:03d}-{time_step_s * 1e3:g}ms{'-neighbour' if neighbour else ''}.json"
+
+
+def walks(settings: BifurcationSettings, out: Path, client, progress: Callable[[int, int], None] | None = None
+          ) -> dict[tuple[int, float, bool], dict[str, Any]]:
+    """Every point's walk, and the neighbour walk of each irregular one, kept in out/walks as each finishes;
+    results by (index, time step, neighbour)."""
+    from drake_biped.experiments.executor import run_kept
+
+    jobs: dict[Any, tuple] = {(i, h, False): (_walk_path(out, i, h), point_config(settings, value, h).to_dict())
+                              for i, value in enumerate(settings.values) for h in settings.time_steps}
+    results = run_kept(client, jobs, progress)
+    if not settings.lyapunov:
+        return results
+    kicked = {}
+    for (i, h, _), (_, config) in jobs.items():
+        walk = results[(i, h, False)]
+        label = attractor_of_walk(walk, settings.config.sim.distance_m, settings.transient_m)
+        if label["attractor"] != "irregular":
+            continue
+        kick = {"time_s": walk["steps"][label["first_kept_step"]]["touchdown_time_s"] + KICK_AFTER_TOUCHDOWN_S,
+                "hip_rate_radps": NEIGHBOUR_KICK_RADPS}
+        kicked[(i, h, True)] = (_walk_path(out, i, h, True), config, kick)
+    results.update(run_kept(client, kicked, progress))
+    return results
+
+
+def bifurcation(settings: BifurcationSettings, out: Path, client, progress=None) -> dict[str, Any]:
+    """The record of `settings` on `client` (module text): one point per value and plant step."""
+    results = walks(settings, out, client, progress)
+    distance = settings.config.sim.distance_m
+    points = []
+    for h in settings.time_steps:
+        for i, value in enumerate(settings.values):
+            walk = results[(i, h, False)]
+            point = {"value": float(value), "time_step_s": h,
+                     **attractor_of_walk(walk, distance, settings.transient_m)}
+            jittered = step_period_label(point["step_periods_s"], fell=point["fell"],
+                                         tolerance_s=settings.jitter_tolerance_s)
+            point["within_jitter"] = {"attractor": jittered["attractor"], "period": jittered["period"],
+                                      "tolerance_s": settings.jitter_tolerance_s}
+            point["lyapunov"] = None
+            neighbour = results.get((i, h, True))
+            if neighbour is not None:
+                other = attractor_of_walk(neighbour, distance, settings.transient_m)
+                n = min(len(point["sections"]), len(other["sections"]))
+                if n >= 3 and not other["fell"]:
+                    point["lyapunov"] = {**lyapunov_from_neighbours(np.array(point["sections"][:n]),
+                                                                    np.array(other["sections"][:n]),
+                                                                    saturation=LYAPUNOV_SATURATION),
+                                         "kick_hip_rate_radps": NEIGHBOUR_KICK_RADPS}
+            points.append(point)
+    return {"param": settings.param, "values": [float(v) for v in settings.values],
+            "time_steps_s": list(settings.time_steps), "transient_m": settings.transient_m,
+            "distance_m": distance, "period_window": PERIOD_WINDOW, "period_tolerance_s": PERIOD_TOLERANCE_S,
+            "jitter_tolerance_s": settings.jitter_tolerance_s, "max_period": MAX_PERIOD, "points": points}
+
+
+def markdown(record: dict[str, Any]) -> str:
+    """bifurcation.md: one row per point."""
+    jitter = record["jitter_tolerance_s"]
+    lines = [f"# Bifurcation over {record['param']}", "",
+             f"Walks of {record['distance_m']:g} m; the steps within {record['transient_m']:g} m of the first "
+             f"touchdown dropped; period-k where every k-th of the last periods varies by less than "
+             f"{1e3 * record['period_tolerance_s']:g} ms (period-1: the last {record['period_window']}), and read "
+             f"again at {1e3 * jitter:g} ms, the scale of the controller's jitter. Lyapunov: a finite-size exponent "
+             f"(per step) from a neighbour walk kicked by {NEIGHBOUR_KICK_RADPS:g} rad/s on the swing hip.", "",
+             f"| {record['param']} | step (ms) | attractor | at {1e3 * jitter:g} ms | last {record['period_window']} step "
+             "periods (s) | Lyapunov | long-run C_mt (95 %) |", "|---|---|---|---|---|---|---|"]
+    for p in record["points"]:
+        periods = p["step_periods_s"][-record["period_window"]:]
+        span = f"{min(periods):.3f}–{max(periods):.3f}" if periods else "—"
+        lyap = p.get("lyapunov") or {}
+        exponent = "—" if lyap.get("exponent") is None else f"{lyap['exponent']:+.2f}"
+        if p["cost_of_transport"] is None:
+            cmt = "—"
+        else:
+            lo, hi = p["interval_95"] or (None, None)
+            cmt = f"{p['cost_of_transport']:.4f}" + (f" ± {0.5 * (hi - lo):.4f}" if lo is not None else "")
+        lines.append(f"| {p['value']:g} | {1e3 * p['time_step_s']:g} | {p['attractor']} | "
+                     f"{p['within_jitter']['attractor']} | {span} | {exponent} | {cmt} |")
+    return "\n".join(lines) + "\n"
+
+
+def figure(record: dict[str, Any], path: Path) -> None:
+    """Garcia-style: every kept step period, and the section's hip angle, against the parameter (one marker
+    per plant step), falls marked on the axis; the attractor named above each value."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8.0, 6.0), sharex=True)
+    markers = {h: (m, c) for h, m, c in zip(record["time_steps_s"], ("o", "x"), ("C0", "C3"))}
+    for h in record["time_steps_s"]:
+        m, c = markers[h]
+        points = [p for p in record["points"] if p["time_step_s"] == h]
+        for p in points:
+            if p["fell"]:
+                continue
+            periods = p["step_periods_s"][-4 * PERIOD_WINDOW:]
+            angles = [s[0] for s in p["sections"][-4 * PERIOD_WINDOW:]]
+            top.plot([p["value"]] * len(periods), periods, marker=m, ls="", ms=2.5, color=c, alpha=0.6)
+            bottom.plot([p["value"]] * len(angles), angles, marker=m, ls="", ms=2.5, color=c, alpha=0.6)
+        top.plot([], [], marker=m, ls="", color=c, label=f"plant step {1e3 * h:g} ms")
+    fell = [p["value"] for p in record["points"] if p["fell"]]
+    if fell:
+        for ax in (top, bottom):
+            ax.plot(fell, [ax.get_ylim()[0]] * len(fell), marker="v", color="k", ls="", label="falls")
+    for p in record["points"]:
+        if p["time_step_s"] == record["time_steps_s"][0]:
+            top.annotate(p["attractor"].replace("period-", "P"), (p["value"], 1.0), xycoords=("data", "axes fraction"),
+                         ha="center", va="bottom", fontsize=7)
+    top.set_ylabel("step period (s)")
+    bottom.set_ylabel("hip angle at touchdown (rad)")
+    bottom.set_xlabel(record["param"])
+    top.legend(fontsize=8, loc="lower right")
+    fig.suptitle(f"Steps after the first {record['transient_m']:g} m of {record['distance_m']:g} m walks", fontsize=10,
+                 y=0.995)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def run(settings: BifurcationSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """The diagram on `client` (a LocalCluster when None); writes bifurcation.json, bifurcation.md and
+    bifurcation.png into `out` (the walks and orbits kept in out/walks and out/orbits). The record."""
+    check_settings(settings, BifurcationSettings, "bifurcation.run")
+    from drake_biped.experiments.executor import client_or_local
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(settings.values) * len(settings.time_steps), desc="bifurcation", unit="walk")
+
+    def tick(done: int, total: int) -> None:
+        if bar is not None:
+            bar.total = max(bar.total, total)
+            bar.n = done
+            bar.refresh()
+
+    with client_or_local(client) as c:
+        record = bifurcation(settings, out, c, tick)
+    if bar is not None:
+        bar.close()
+    record.update(config=settings.config.to_dict(), versions=versions())
+    write_atomic(out / "bifurcation.json", record)
+    write_text_atomic(out / "bifurcation.md", markdown(record))
+    figure(record, out / "bifurcation.png")
+    return record
+
+
+# The command line: `drake-biped bifurcation` (drake_biped/cli.py runs `command`).
+COMMAND = "bifurcation"
+PARSER = dict(help="long walks over a range of one parameter: the attractor each settles on (period-k, irregular, "
+              "fall), read at 2 ms and at the controller's jitter, irregular ones with a Lyapunov exponent (on Dask, "
+              "resumable)")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped bifurcation`'s options."""
+    from drake_biped.experiments.options import add_window_options
+
+    p.add_argument("--param", required=True,
+                   help="the parameter: t1, t2, slope, speed, hip_angle, u_a, u_r, kappa, or any section.field")
+    p.add_argument("--from", dest="start", required=True, type=number("finite"), help="first value")
+    p.add_argument("--to", dest="stop", required=True, type=number("finite"), help="last value")
+    p.add_argument("--num", required=True, type=count, help="values from --from to --to, evenly spaced")
+    add_episode_options(p)
+    add_window_options(p)
+    p.add_argument("--transient", type=number("nonnegative"), default=TRANSIENT_M,
+                   help="steps within this distance of the first touchdown are dropped (m)")
+    p.add_argument("--second-time-step", type=number("positive"), default=None,
+                   help="walk every value at this plant step too (s)")
+    p.add_argument("--jitter-tolerance", type=number("positive"), default=JITTER_TOLERANCE_S,
+                   help="the second reading's tolerance on every k-th step period (s)")
+    p.add_argument("--no-lyapunov", action="store_true", help="no neighbour walks (no Lyapunov exponents)")
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder (rerun the same command to resume)")
+
+
+def settings_from_args(args: argparse.Namespace) -> BifurcationSettings:
+    """The settings of `args`: the window of --policy or --t1/--t2 (either may be given alone, the other taken
+    from --params; the swept one is set point by point), the walk 60 m unless --distance says otherwise."""
+    config = episode_config(args)
+    if args.distance is None:
+        config = config.override({"sim.distance_m": 60.0, "sim.max_time_s": max(config.sim.max_time_s, 360.0)})
+    if args.policy is not None:
+        if args.t1 is not None or args.t2 is not None:
+            raise ParameterError("give either --policy or --t1/--t2, not both")
+        from drake_biped.experiments.options import policy_window
+
+        t1, t2 = policy_window(Path(args.policy))
+        config = config.override({"window.start_s": t1, "window.end_s": t2})
+    named = {"window.start_s": args.t1, "window.end_s": args.t2}
+    config = config.override({k: v for k, v in named.items() if v is not None})
+    values = tuple(float(v) for v in np.linspace(args.start, args.stop, args.num))
+    return BifurcationSettings(config, args.param, values, second_time_step_s=args.second_time_step,
+                               transient_m=args.transient, jitter_tolerance_s=args.jitter_tolerance,
+                               lyapunov=not args.no_lyapunov, force=args.force)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = settings_from_args(args)
+    out = Path(args.out)
+    from drake_biped.experiments.options import cluster
+
+    with cluster(args) as client:
+        record = run(settings, out, client)
+    print(markdown(record))
+    print(f"wrote {out}/bifurcation.json, bifurcation.md, bifurcation.png")
+    return 0

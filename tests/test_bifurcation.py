@@ -1,0 +1,68 @@
+"""The bifurcation diagram: its points are the walks the API makes, labelled by the step-period rule, and a
+rerun resumes from the kept walks."""
+
+import json
+
+import numpy as np
+import pytest
+
+from drake_biped.episode import run_episode
+from drake_biped.experiments import bifurcation
+from drake_biped.params import EpisodeConfig, ParameterError
+from tests.test_failures import one_line, run_cli
+
+
+def _walk(periods, com_step=0.2, fell=False, distance=None):
+    """An episode result dictionary whose touchdowns come `periods` apart, each step `com_step` long."""
+    times = np.concatenate([[0.5], 0.5 + np.cumsum(periods)])
+    steps = [{"touchdown_time_s": float(t), "com_x_m": com_step * k, "positive_work_j": 10.0 * k,
+              "hip_angle_rad": 0.7 + 0.01 * k, "hip_rate_radps": 2.0} for k, t in enumerate(times)]
+    walked = com_step * (len(times) - 1)
+    return {"steps": steps, "fell": fell, "fall_reason": "hip_low" if fell else "", "mass_kg": 10.0,
+            "distance_m": walked if distance is None else distance}
+
+
+def test_the_transient_is_dropped_and_the_rest_labelled():
+    periods = np.concatenate([np.full(20, 0.6), np.tile([0.41, 0.47], 30)])  # 4 m of transient, then period-2
+    label = bifurcation.attractor_of_walk(_walk(periods), distance_m=1.0, transient_m=4.0)
+    assert label["first_kept_step"] == 20
+    assert label["step_periods_s"] == pytest.approx(periods[20:])
+    assert label["attractor"] == "period-2" and label["period"] == 2
+    # the long-run C_mt of the kept steps: 10 J per 0.2 m step, m g d = 10 * 9.81 * 0.2
+    assert label["cost_of_transport"] == pytest.approx(10.0 / (10.0 * 9.81 * 0.2))
+    short = bifurcation.attractor_of_walk(_walk(periods, distance=3.0), distance_m=5.0, transient_m=4.0)
+    assert short["fell"] and short["attractor"] == "fell" and short["cost_of_transport"] is None
+
+
+def test_points_are_the_api_walks_and_a_rerun_resumes(tmp_path, client):
+    config = EpisodeConfig().override({"sim.distance_m": 9.0, "sim.max_time_s": 40.0, "window.end_s": 0.944})
+    settings = bifurcation.BifurcationSettings(config, "t1", (0.46,), transient_m=3.0, lyapunov=False)
+    record = bifurcation.run(settings, tmp_path, client, progress=False)
+    (point,) = record["points"]
+    walk = run_episode(bifurcation.point_config(settings, 0.46, 0.001))
+    td = walk.touchdowns
+    first = int(np.searchsorted(td["com_x_m"] - td["com_x_m"][0], 3.0))
+    assert point["step_periods_s"] == pytest.approx(np.diff(td["touchdown_time_s"][first:]).tolist(), abs=0)
+    assert point["cost_of_transport"] == pytest.approx(walk.long_run(transient_m=3.0)["cost_of_transport"])
+    # period-1 exactly where the last 20 periods vary by less than 2 ms
+    spread = np.ptp(point["step_periods_s"][-20:])
+    assert (point["attractor"] == "period-1") == (spread < 0.002)
+    kept = sorted((tmp_path / "walks").iterdir())
+    stamps = [p.stat().st_mtime_ns for p in kept]
+    again = bifurcation.run(settings, tmp_path, client, progress=False)
+    assert [p.stat().st_mtime_ns for p in kept] == stamps  # read back, not walked again
+    assert again["points"] == json.loads(json.dumps(record["points"]))
+    assert (tmp_path / "bifurcation.png").stat().st_size > 0
+
+
+def test_bad_parameters_are_one_line(capsys, tmp_path):
+    with pytest.raises(ParameterError, match="u_q"):
+        bifurcation.BifurcationSettings(param="u_q")
+    code, lines = run_cli(capsys, ["bifurcation", "--param", "cpg.nope", "--from", "0", "--to", "1", "--num", "2",
+                                   "--out", str(tmp_path / "b")])
+    assert code == 2
+    one_line(lines, "cpg.nope")
+    code, lines = run_cli(capsys, ["bifurcation", "--param", "t1", "--from", "0.3", "--to", "0.4", "--num", "999",
+                                   "--out", str(tmp_path / "c")])
+    assert code == 2
+    one_line(lines, "1998 walks", "--force")
