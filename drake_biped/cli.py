@@ -98,7 +98,7 @@ RESUMABLE = ("gait-search", "learn", "compare-learners", "stability", "grid", "s
 
 # The experiments with a command of their own, in the order `drake-biped --help` lists them.
 EXPERIMENT_COMMANDS = ("walk", "window_map", "gait_search", "time_step", "learning", "compare_learners", "landscape",
-                       "stability", "rewalk", "floquet", "bifurcation", "push_margin", "grid", "slope", "reproduce")
+                       "stability", "rewalk", "floquet", "bifurcation", "basins", "push_margin", "grid", "slope", "reproduce")
 
 
 def experiment_commands() -> list:

@@ -66,3 +66,21 @@ def test_bad_parameters_are_one_line(capsys, tmp_path):
                                    "--out", str(tmp_path / "c")])
     assert code == 2
     one_line(lines, "1998 walks", "--force")
+
+
+def test_basins_walk_each_start_with_and_without_the_window(tmp_path, client):
+    from drake_biped.experiments import basins
+
+    config = EpisodeConfig().override({"sim.distance_m": 6.0, "sim.max_time_s": 30.0})
+    settings = basins.BasinSettings(config, (0.405, 0.944), (0.12, 0.14), (0.19,), transient_m=2.0)
+    start = basins.start_config(settings, "with", 0.14, 0.19)
+    assert (start.initial.hip_angle_rad, start.initial.speed_mps) == (0.14, 0.19)
+    assert (start.window.start_s, start.window.end_s) == (0.405, 0.944)
+    assert basins.start_config(settings, "without", 0.14, 0.19).window.end_s == 0.0
+    record = basins.run(settings, tmp_path, client, progress=False)
+    walk = run_episode(start)
+    cell = record["grids"]["with"][1][0]
+    assert cell["distance_m"] == walk.distance_m and cell["fell"] == walk.fell
+    td = walk.touchdowns
+    first = int(np.searchsorted(td["com_x_m"] - td["com_x_m"][0], 2.0))
+    assert cell["step_period_mean_s"] == pytest.approx(np.mean(np.diff(td["touchdown_time_s"][first:])[-20:]))

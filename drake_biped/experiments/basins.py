@@ -1,0 +1,248 @@
+"""Where walks from different starts end (`drake-biped basins`): a slice of initial conditions (the initiation's
+hip angle x its speed), each start walked long and read by what it settles on (`bifurcation.attractor_of_walk`:
+period-k, irregular, or a fall), with and without a torque-free window. Coexisting gaits show as regions of
+different attractors, or of different step periods, in the same slice. Walks are kept in `walks/` as each
+finishes: a rerun of the same command resumes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.analysis.attractor import step_period_label
+from drake_biped.analysis.long_run import TRANSIENT_M
+from drake_biped.experiments.bifurcation import JITTER_TOLERANCE_S, attractor_of_walk
+from drake_biped.experiments.options import (
+    add_cluster_options,
+    add_episode_options,
+    add_window_options,
+    chosen_window,
+    episode_config,
+    number,
+    out_folder,
+)
+from drake_biped.experiments.stability import CONDITIONS, condition_window
+from drake_biped.params import EpisodeConfig, ParameterError, check_settings
+from drake_biped.records import save_figure, write_atomic, write_text_atomic
+from drake_biped.versions import versions
+
+__all__ = ["BasinSettings", "basins", "run", "markdown"]
+
+MAX_WALKS = 800
+
+
+@dataclass(frozen=True)
+class BasinSettings:
+    """The gait, the window compared with none, the grid of starts and the transient dropped."""
+
+    config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 30.0,
+                                                                                    "sim.max_time_s": 180.0}))
+    window: tuple[float, float] = (0.2, 0.5)
+    hip_angles_rad: tuple[float, ...] = (0.10, 0.13, 0.16)
+    speeds_mps: tuple[float, ...] = (0.15, 0.175, 0.20)
+    transient_m: float = TRANSIENT_M
+    force: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("hip_angles_rad", "speeds_mps"):
+            values = getattr(self, name)
+            if not values or any(not (isinstance(v, (int, float)) and math.isfinite(v)) for v in values):
+                raise ParameterError(f"basins: {name} must be finite numbers, got {values!r}")
+        if not (0 <= self.transient_m < self.config.sim.distance_m):
+            raise ParameterError(f"--transient {self.transient_m:g} m must lie below --distance "
+                                 f"{self.config.sim.distance_m:g} m")
+        if self.walks > MAX_WALKS and not self.force:
+            raise ParameterError(f"basins: {self.walks} walks is above {MAX_WALKS}; coarsen the grid, or give --force")
+
+    @property
+    def walks(self) -> int:
+        return len(CONDITIONS) * len(self.hip_angles_rad) * len(self.speeds_mps)
+
+
+def start_config(settings: BasinSettings, condition: str, hip_angle: float, speed: float) -> EpisodeConfig:
+    """The walk from one start, without or with the settings' window."""
+    config = settings.config.override({"initial.hip_angle_rad": float(hip_angle), "initial.speed_mps": float(speed)})
+    return config.replace(window=condition_window(condition, settings.window))
+
+
+def basins(settings: BasinSettings, out: Path, client, progress=None) -> dict[str, Any]:
+    """The record of `settings` on `client`: per condition, a grid [hip angle][speed] of what each start ends on."""
+    from drake_biped.experiments.executor import run_kept
+
+    jobs = {}
+    for condition in CONDITIONS:
+        for i, a in enumerate(settings.hip_angles_rad):
+            for j, v in enumerate(settings.speeds_mps):
+                path = out / "walks" / f"{condition}-{i:02d}-{j:02d}.json"
+                jobs[(condition, i, j)] = (path, start_config(settings, condition, a, v).to_dict())
+    results = run_kept(client, jobs, progress)
+    distance = settings.config.sim.distance_m
+    grids: dict[str, list[list[dict]]] = {}
+    for condition in CONDITIONS:
+        grid = []
+        for i in range(len(settings.hip_angles_rad)):
+            row = []
+            for j in range(len(settings.speeds_mps)):
+                label = attractor_of_walk(results[(condition, i, j)], distance, settings.transient_m)
+                periods = label["step_periods_s"][-20:]
+                coarse = step_period_label(label["step_periods_s"], fell=label["fell"], tolerance_s=JITTER_TOLERANCE_S)
+                row.append({"attractor": label["attractor"], "within_jitter": coarse["attractor"],
+                            "fell": label["fell"], "distance_m": label["distance_m"],
+                            "step_period_mean_s": float(np.mean(periods)) if periods else None,
+                            "spread_s": label["spread_s"], "cost_of_transport": label["cost_of_transport"]})
+            grid.append(row)
+        grids[condition] = grid
+    return {"window": list(settings.window), "hip_angles_rad": list(settings.hip_angles_rad),
+            "speeds_mps": list(settings.speeds_mps), "distance_m": distance, "transient_m": settings.transient_m,
+            "jitter_tolerance_s": JITTER_TOLERANCE_S, "grids": grids}
+
+
+def _kind(cell: dict) -> str:
+    """A cell's reading for the figure: the strict label, else the jitter-scale one."""
+    if cell["fell"]:
+        return "falls"
+    if cell["attractor"].startswith("period-"):
+        return cell["attractor"]
+    if cell["within_jitter"].startswith("period-"):
+        return f"{cell['within_jitter']} (jitter)"
+    return cell["attractor"]
+
+
+def markdown(record: dict[str, Any]) -> str:
+    """basins.md: per condition, how many starts end on each attractor, and the range of their step periods."""
+    lines = [f"# Basins: {len(record['hip_angles_rad'])} initial hip angles x {len(record['speeds_mps'])} speeds",
+             "", f"Walks of {record['distance_m']:g} m, the first {record['transient_m']:g} m dropped; window "
+             f"{record['window'][0]:g}–{record['window'][1]:g} s.", "",
+             "| condition | attractor | starts | mean step period (s) | long-run C_mt |", "|---|---|---|---|---|"]
+    for condition, grid in record["grids"].items():
+        cells = [c for row in grid for c in row]
+        for kind in sorted({_kind(c) for c in cells}):
+            group = [c for c in cells if _kind(c) == kind]
+            periods = [c["step_period_mean_s"] for c in group if c["step_period_mean_s"] is not None and not c["fell"]]
+            costs = [c["cost_of_transport"] for c in group if c["cost_of_transport"] is not None]
+            lines.append(f"| {condition} | {kind} | {len(group)} | "
+                         + (f"{min(periods):.3f}–{max(periods):.3f}" if periods else "—") + " | "
+                         + (f"{min(costs):.3f}–{max(costs):.3f}" if costs else "—") + " |")
+    return "\n".join(lines) + "\n"
+
+
+def figure(record: dict[str, Any], path: Path) -> None:
+    """One panel per condition: each start coloured by its mean step period, a fall as a cross, an irregular
+    walk ringed."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    a, v = np.array(record["hip_angles_rad"]), np.array(record["speeds_mps"])
+    fig, axes = plt.subplots(1, len(record["grids"]), figsize=(10.0, 4.2), sharey=True)
+    periods = [c["step_period_mean_s"] for g in record["grids"].values() for row in g for c in row
+               if not c["fell"] and c["step_period_mean_s"] is not None]
+    vmin, vmax = (min(periods), max(periods)) if periods else (0.0, 1.0)
+    scatter = None
+    for ax, (condition, grid) in zip(np.atleast_1d(axes), record["grids"].items()):
+        for i, angle in enumerate(a):
+            for j, speed in enumerate(v):
+                c = grid[i][j]
+                if c["fell"]:
+                    ax.plot(speed, angle, "kx", ms=7)
+                    continue
+                scatter = ax.scatter(speed, angle, c=[c["step_period_mean_s"]], cmap="viridis", vmin=vmin, vmax=vmax,
+                                     s=90, marker="s")
+                if not _kind(c).startswith("period-"):
+                    ax.scatter(speed, angle, s=160, facecolors="none", edgecolors="r", linewidths=1.2)
+        ax.set_title(f"{condition} the window", fontsize=9)
+        ax.set_xlabel("initiation speed (m/s)")
+    np.atleast_1d(axes)[0].set_ylabel("initial hip angle (rad)")
+    if scatter is not None:
+        fig.colorbar(scatter, ax=axes, label="mean step period after the transient (s)")
+    fig.suptitle("Where each start ends: colour the step period; x falls; red ring: irregular", fontsize=10)
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def run(settings: BasinSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
+    """The slice on `client` (a LocalCluster when None); writes basins.json, basins.md and basins.png into `out`
+    (the walks kept in out/walks). The record."""
+    check_settings(settings, BasinSettings, "basins.run")
+    from drake_biped.experiments.executor import client_or_local
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=settings.walks, desc="basins", unit="walk")
+
+    def tick(done: int, total: int) -> None:
+        if bar is not None:
+            bar.n = done
+            bar.refresh()
+
+    with client_or_local(client) as c:
+        record = basins(settings, out, c, tick)
+    if bar is not None:
+        bar.close()
+    record.update(config=settings.config.to_dict(), versions=versions())
+    write_atomic(out / "basins.json", record)
+    write_text_atomic(out / "basins.md", markdown(record))
+    figure(record, out / "basins.png")
+    return record
+
+
+# The command line: `drake-biped basins` (drake_biped/cli.py runs `command`).
+COMMAND = "basins"
+PARSER = dict(help="a slice of starts (initial hip angle x speed) coloured by what each walk ends on, with and "
+              "without a torque-free period (on Dask, resumable)")
+
+
+def _grid(text: str) -> tuple[float, ...]:
+    """A:B:N, N values from A to B."""
+    try:
+        a, b, n = text.split(":")
+        values = tuple(float(x) for x in np.linspace(float(a), float(b), int(n)))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not A:B:N (N values from A to B)") from None
+    if int(n) < 1 or not all(math.isfinite(x) for x in values):
+        raise argparse.ArgumentTypeError(f"{text!r} is not A:B:N with N >= 1 and finite A, B")
+    return values
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """`drake-biped basins`'s options."""
+    p.add_argument("--hip-angles", type=_grid, default=(0.10, 0.13, 0.16),
+                   help="initial hip angles A:B:N (rad)")
+    p.add_argument("--speeds", type=_grid, default=(0.15, 0.175, 0.20), help="initiation speeds A:B:N (m/s)")
+    add_episode_options(p)
+    add_window_options(p)
+    p.add_argument("--transient", type=number("nonnegative"), default=TRANSIENT_M,
+                   help="steps within this distance of the first touchdown are dropped (m)")
+    add_cluster_options(p)
+    p.add_argument("--out", required=True, type=out_folder, help="output folder (rerun the same command to resume)")
+
+
+def settings_from_args(args: argparse.Namespace) -> BasinSettings:
+    config = episode_config(args)
+    if args.distance is None:
+        config = config.override({"sim.distance_m": 30.0, "sim.max_time_s": max(config.sim.max_time_s, 180.0)})
+    return BasinSettings(config, chosen_window(args), tuple(args.hip_angles), tuple(args.speeds),
+                         transient_m=args.transient, force=args.force)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.experiments.options import cluster
+
+    settings = settings_from_args(args)
+    with cluster(args) as client:
+        record = run(settings, Path(args.out), client)
+    print(markdown(record))
+    print(f"wrote {args.out}/basins.json, basins.md, basins.png")
+    return 0
