@@ -84,3 +84,17 @@ def test_basins_walk_each_start_with_and_without_the_window(tmp_path, client):
     td = walk.touchdowns
     first = int(np.searchsorted(td["com_x_m"] - td["com_x_m"][0], 2.0))
     assert cell["step_period_mean_s"] == pytest.approx(np.mean(np.diff(td["touchdown_time_s"][first:])[-20:]))
+
+
+def test_envelopes_and_the_slope_premise():
+    def points(fell):
+        return [{"value": 0.01 * k, "fell": f} for k, f in enumerate(fell)]
+
+    without = points([False, False, False, True, False])
+    with_window = points([False, True, True, True, True])
+    assert bifurcation.walked_up_to(without) == 0.02  # the walk at 0.04 does not count: 0.03 fell before it
+    assert bifurcation.walked_up_to(points([True, False])) is None
+    p = bifurcation.premise(without, with_window)
+    assert p["without_up_to"] == 0.02 and p["with_up_to"] == 0.0 and p["band"] == [0.01, 0.02, 0.04] and p["holds"]
+    assert not bifurcation.premise(with_window, without)["holds"]  # the window never fails where none climbs
+    assert bifurcation.premise(points([False, True]), points([False, True]))["band"] == []

@@ -47,7 +47,7 @@ from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, chec
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["BifurcationSettings", "attractor_of_walk", "run", "markdown"]
+__all__ = ["BifurcationSettings", "attractor_of_walk", "markdown", "premise", "run", "walked_up_to"]
 
 # At most this many walks without --force.
 MAX_WALKS = 400
@@ -134,6 +134,29 @@ def attractor_of_walk(result: dict[str, Any], distance_m: float, transient_m: fl
             "interval_95": None if long_run is None else long_run["interval_95"]}
 
 
+def walked_up_to(points: list[dict[str, Any]]) -> float | None:
+    """The envelope of a sweep (points in the order of their values, one plant step): the last value up to
+    which every walk, from the first value on, walks its distance (None when the first falls). Over the slope:
+    the steepest slope the gait climbs."""
+    last = None
+    for p in points:
+        if p["fell"]:
+            break
+        last = p["value"]
+    return last
+
+
+def premise(without: list[dict[str, Any]], with_window: list[dict[str, Any]]) -> dict[str, Any]:
+    """The paper's slope premise read off two sweeps over the same slopes, without and with a window: each
+    one's envelope, and the band of slopes where the window's walk falls and the walk without one climbs (the
+    paper's story needs it: "unable to climb with the torque-free period ... able without")."""
+    if [p["value"] for p in without] != [p["value"] for p in with_window]:
+        raise ValueError("premise: the two sweeps must cover the same values")
+    band = [a["value"] for a, b in zip(without, with_window) if b["fell"] and not a["fell"]]
+    return {"without_up_to": walked_up_to(without), "with_up_to": walked_up_to(with_window), "band": band,
+            "holds": bool(band)}
+
+
 def _walk_path(out: Path, i: int, time_step_s: float, neighbour: bool = False) -> Path:
     return out / "walks" / f"{i:03d}-{time_step_s * 1e3:g}ms{'-neighbour' if neighbour else ''}.json"
 
@@ -190,7 +213,8 @@ def bifurcation(settings: BifurcationSettings, out: Path, client, progress=None)
     return {"param": settings.param, "values": [float(v) for v in settings.values],
             "time_steps_s": list(settings.time_steps), "transient_m": settings.transient_m,
             "distance_m": distance, "period_window": PERIOD_WINDOW, "period_tolerance_s": PERIOD_TOLERANCE_S,
-            "jitter_tolerance_s": settings.jitter_tolerance_s, "max_period": MAX_PERIOD, "points": points}
+            "jitter_tolerance_s": settings.jitter_tolerance_s, "max_period": MAX_PERIOD, "points": points,
+            "walked_up_to": walked_up_to([p for p in points if p["time_step_s"] == settings.time_steps[0]])}
 
 
 def markdown(record: dict[str, Any]) -> str:
@@ -216,6 +240,9 @@ def markdown(record: dict[str, Any]) -> str:
             cmt = f"{p['cost_of_transport']:.4f}" + (f" ± {0.5 * (hi - lo):.4f}" if lo is not None else "")
         lines.append(f"| {p['value']:g} | {1e3 * p['time_step_s']:g} | {p['attractor']} | "
                      f"{p['within_jitter']['attractor']} | {span} | {exponent} | {cmt} |")
+    up_to = record.get("walked_up_to")
+    lines += ["", f"Every walk from {record['param']} = {record['values'][0]:g} walks up to "
+              + ("none: the first falls." if up_to is None else f"{up_to:g}.")]
     return "\n".join(lines) + "\n"
 
 
