@@ -329,3 +329,22 @@ def test_the_decay_check_stays_inside_the_linear_range():
     assert decay_size(settings, plateau, 0.5) == 3e-5
     assert decay_size(settings, {"plateau": None}, 4.0) == 1e-6
     assert decay_size(FloquetSettings(decay_floor=1e-9), plateau, 100.0) == 1e-9
+
+
+def test_floquet_reports_the_period_the_map_settles_on():
+    """A map whose attractor is the logistic map's period-2 orbit at r = 3.2 (the 2-fold map's multiplier
+    4 + 2r - r^2 = 0.16), beside a coordinate the section normal marks trivial; then one with no period."""
+    from drake_biped.experiments.floquet import FloquetSettings, orbit_period
+
+    def logistic(r):
+        def evaluate(points):
+            return [np.array([r * p[0] * (1 - p[0]), 0.0]) for p in points]
+        return evaluate
+
+    settings = FloquetSettings(period_transient=200, newton_tolerance=1e-12)
+    found = orbit_period(settings, logistic(3.2), np.array([0.3, 0.5]), np.array([0.0, 1.0]))
+    assert found["period"] == 2
+    assert len(found["multipliers"]) == 1
+    assert found["multipliers"][0][0] == pytest.approx(0.16, abs=1e-5)
+    chaos = orbit_period(settings, logistic(4.0), np.array([0.3, 0.5]), np.array([0.0, 1.0]))
+    assert chaos["period"] is None and chaos["spread"] > 0.5

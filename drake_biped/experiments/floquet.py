@@ -59,6 +59,10 @@ class FloquetSettings:
     # decay_floor.
     decay_size: float = 1e-6
     decay_floor: float = 1e-10
+    # The orbit's period: the map iterated period_transient times from the settled section, then the smallest
+    # k <= 8 with which its iterates repeat to within period_tolerance (relative; `floquet.periodic_orbit`).
+    period_transient: int = 60
+    period_tolerance: float = 1e-6
 
     def __post_init__(self) -> None:
         if not isinstance(self.settle_steps, int) or self.settle_steps < 1:
@@ -76,7 +80,8 @@ class FloquetSettings:
         return {"settle_steps": self.settle_steps, "epsilons": list(self.epsilons),
                 "newton_epsilon": self.newton_epsilon, "newton_tolerance": self.newton_tolerance,
                 "newton_iterations": self.newton_iterations, "plateau_tolerance": self.plateau_tolerance,
-                "decay_steps": self.decay_steps, "decay_size": self.decay_size, "decay_floor": self.decay_floor}
+                "decay_steps": self.decay_steps, "decay_size": self.decay_size, "decay_floor": self.decay_floor,
+                "period_transient": self.period_transient, "period_tolerance": self.period_tolerance}
 
 
 def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
@@ -129,6 +134,32 @@ def orbit_radius(config: EpisodeConfig, settle_steps: int = 8, epsilon: float = 
     return {"spectral_radius": mult.nontrivial_radius(), "fixed_point_residual": fixed.residual}
 
 
+def orbit_period(settings: FloquetSettings, evaluate: fq.Batch, z0: np.ndarray, normal: np.ndarray) -> dict[str, Any]:
+    """The period of the orbit the section map settles on (`floquet.periodic_orbit`): {"period": k, "multipliers"
+    of the k-fold map (non-trivial, [re, im], largest first), "residual", "spread"} or, where no period up to 8
+    repeats, {"period": None, "spread"}; "spread": the largest coordinate range over the last 16 iterates."""
+    def step(z):
+        (y,) = evaluate([z])
+        if y is None:
+            raise fq.StepFailed("the walker falls on the map's iterates")
+        return y
+
+    try:
+        orbit = fq.periodic_orbit(step, z0, transient=settings.period_transient,
+                                  detect_tolerance=settings.period_tolerance, epsilon=settings.newton_epsilon,
+                                  tolerance=settings.newton_tolerance, max_iterations=settings.newton_iterations)
+    except fq.NoPeriodicOrbit as exc:
+        tail = exc.iterates[-16:]
+        return {"period": None, "spread": float(np.max(np.ptp(tail, axis=0)))}
+    except fq.StepFailed as exc:
+        return {"period": None, "spread": None, "error": str(exc)}
+    mult = fq.multipliers(orbit.jacobian, normal)
+    keep = [v for v, t in zip(mult.values, mult.trivial) if t is None]
+    return {"period": orbit.period, "multipliers": complex_list(np.array(keep)), "residual": orbit.residual,
+            "spectral_radius": float(max(abs(v) for v in keep)) if keep else None,
+            "spread": float(np.max(np.ptp(orbit.points, axis=0)))}
+
+
 def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     """The fixed point, the sweep, the multipliers and the cross-checks of `settings.config`'s gait."""
     from drake_biped.analysis.step_map import SectionMap
@@ -139,6 +170,7 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     names = list(section_map.names)
     cfg, tmpl = settings.config.to_dict(), template.to_dict()
     evaluate = _batch(client, cfg, tmpl)
+    period = orbit_period(settings, evaluate, z0, section_map.section_normal())
 
     fixed = fq.newton_fixed_point(evaluate, z0, settings.newton_epsilon, tolerance=settings.newton_tolerance,
                                   max_iterations=settings.newton_iterations, max_halvings=8)
@@ -219,6 +251,7 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
         "decay": decay,
         "sampling_phase_drift": phase,
         "template": tmpl,
+        "orbit_period": period,
         "wall_time_s": time.perf_counter() - wall0,
     }
 
@@ -261,6 +294,20 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
     rest = len(record["multipliers"]) - 6
     if rest > 0:
         lines.append(f"| … {rest} more below {math.hypot(*record['multipliers'][6]):.1e} | | |")
+    period = record.get("orbit_period")
+    if period:
+        transient, tol = record["settings"]["period_transient"], record["settings"]["period_tolerance"]
+        if period.get("period"):
+            k = period["period"]
+            lead = period["multipliers"][0] if period.get("multipliers") else None
+            lines += ["", f"**The map's attractor: period-{k}** (its iterates after {transient} steps repeat every {k} "
+                      f"to {tol:g}); the {k}-fold map's leading multiplier "
+                      + (f"{lead[0]:.4f}{lead[1]:+.4f}i (|{math.hypot(*lead):.4f}|)" if lead else "—")
+                      + f", orbit residual {period['residual']:.1e}."]
+        elif period.get("spread") is not None:
+            lines += ["", f"**The map's iterates repeat with no period up to 8** (to {tol:g}, after {transient} "
+                      f"steps; their coordinates still range over up to {period['spread']:.2g}): the period-1 "
+                      "figures above are of the orbit Newton finds nearest, not one the iterates settle on."]
     d = record["decay"]
     lines += ["", "Perturbation of size {:.0e} along the dominant mode, |deviation| per step:".format(d["size"]), "",
               "| step | " + " | ".join(str(k + 1) for k in range(len(d["predicted"]))) + " |",
