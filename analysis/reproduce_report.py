@@ -157,7 +157,10 @@ def table_vii_rows(summary: dict[str, Any]) -> tuple[list[str], str, str]:
 
 # The claims' rows of the full report, in order: the keys a quick run matches its own rows with.
 CLAIM_KEYS = ("table_iii", "paper_gait", "grid", "learn", "learn_variant", "compare_learners", "stability",
-              "push_margin", "floquet", "slope", "slope2deg", "table_vii", "time_step")
+              "push_margin", "floquet", "attractors", "slope_premise", "table_iii_attractor", "slope", "slope2deg",
+              "table_vii", "time_step")
+# The rows of the dynamics step (a run made before it has none).
+DYNAMICS_KEYS = ("attractors", "slope_premise", "table_iii_attractor")
 # The learning runs whose evaluated windows a quick run re-walks (DIR/<source>/learning.json).
 CHECKED_SOURCES = {"learn": ("learn",), "learn_variant": ("learn_variant",)}
 # The shipped gaits other than the default, and why each exists (the report's closing section).
@@ -167,9 +170,78 @@ def _steps(n: int) -> str:
 
 def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]]:
     """The verdict tuples as keyed rows (CLAIM_KEYS)."""
-    if len(verdicts) != len(CLAIM_KEYS):
+    keys = CLAIM_KEYS
+    if len(verdicts) == len(CLAIM_KEYS) - len(DYNAMICS_KEYS):
+        keys = tuple(k for k in CLAIM_KEYS if k not in DYNAMICS_KEYS)
+    if len(verdicts) != len(keys):
         raise ValueError(f"expected {len(CLAIM_KEYS)} claims, got {len(verdicts)}")
-    return [{"key": k, "what": a, "paper": b, "ours": c, "verdict": d} for k, (a, b, c, d) in zip(CLAIM_KEYS, verdicts)]
+    return [{"key": k, "what": a, "paper": b, "ours": c, "verdict": d} for k, (a, b, c, d) in zip(keys, verdicts)]
+
+
+def attractor_text(point: dict[str, Any]) -> str:
+    """A walk's attractor in words: the 2 ms reading, the jitter-scale one where it differs, the exponent."""
+    if point["fell"]:
+        return "falls"
+    text = point["attractor"]
+    jitter = (point.get("within_jitter") or {}).get("attractor")
+    if jitter and jitter != text:
+        text += f" ({jitter} at {1e3 * point['within_jitter']['tolerance_s']:g} ms)"
+    lyap = point.get("lyapunov") or {}
+    if lyap.get("exponent") is not None:
+        text += f", Lyapunov {lyap['exponent']:+.2f}/step"
+    if point.get("spread_s") is not None:
+        text += f", step periods spread {1e3 * point['spread_s']:.0f} ms"
+    return text
+
+
+def dynamics_rows(d: dict[str, Any], wtext: str) -> list[tuple[str, str, str, str]]:
+    """The dynamics step's verdict rows: the attractors, the slope premise, the Table III walker."""
+    none, learned = d["learned"]
+    rows = [("What the walk settles on (110 m)", "—",
+             f"no window: {attractor_text(none)}; {wtext}: {attractor_text(learned)}", BEYOND)]
+    pr = d["premise"]
+    up = {k: "none" if v is None else f"{v:g} rad" for k, v in (("without", pr["without_up_to"]),
+                                                                ("with", pr["with_up_to"]))}
+    band = (f"the window fails and none climbs at {', '.join(f'{v:g}' for v in pr['band'])} rad" if pr["band"]
+            else "no slope where the window fails and none climbs")
+    rows.append(("The slope premise: the learned window cannot climb where none can", "holds at 0.02 rad",
+                 f"climbs 30 m up to: none {up['without']}, {wtext} {up['with']}; {band}",
+                 REPRODUCED if pr["holds"] else NOT_REPRODUCED))
+    rows.append(("Table III, entrained reading (`paper_entrained`): a gait?", "walks",
+                 "; ".join(f"{1e3 * p['time_step_s']:g} ms: {attractor_text(p)}" for p in d["paper_entrained"]),
+                 BEYOND))
+    return rows
+
+
+def dynamics_section(out: Path, d: dict[str, Any], wtext: str) -> list[str]:
+    """The gait as a dynamical system: the bifurcation over t1, the slope envelopes, the basins."""
+    pr = d["premise"]
+    return [
+        "## The gait as a dynamical system (`dynamics/`, beyond the paper)",
+        "",
+        "Each walk is read by its step periods after the first 10 m: period-k where every k-th period varies by "
+        "less than 2 ms, read again at 10 ms (the 1 kHz controller sees a touchdown only at its next update, so "
+        "even a regular gait's periods jitter by a few ms), irregular ones with a finite-size Lyapunov exponent "
+        "from a neighbour walk (`drake-biped bifurcation`, `drake-biped basins`).",
+        "",
+        "### Bifurcation over t1, the learned t2 kept (`dynamics/t1/`)",
+        "",
+        embed(_read(out, "dynamics/t1/bifurcation.md"), "dynamics/t1"),
+        "![bifurcation over t1](dynamics/t1/bifurcation.png)",
+        "",
+        "### The slope premise (`dynamics/slope_without/`, `dynamics/slope_with/`)",
+        "",
+        f"The steepest slope climbed for 30 m after 2 m level (every slope up to it climbed): without a window "
+        f"**{pr['without_up_to']}** rad, with {wtext} **{pr['with_up_to']}** rad. Slopes where the window falls "
+        f"and no window climbs: {', '.join(f'{v:g}' for v in pr['band']) or 'none'}. The paper's slope story "
+        "needs such a band; its 0.02 rad is run as printed in the slope stories below.",
+        "",
+        "### Where starts end (`dynamics/basins/`)",
+        "",
+        embed(_read(out, "dynamics/basins/basins.md"), "dynamics/basins"),
+        "![basins](dynamics/basins/basins.png)",
+        "",
+    ]
 
 
 def walk_section(walk: dict[str, Any]) -> list[str]:
@@ -227,6 +299,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append(("Full-state Floquet multipliers (periodic orbit, through Drake)", "—",
                      ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
                                for name, g in fl.items()), BEYOND))
+    if "dynamics" in s:
+        verdicts += dynamics_rows(s["dynamics"], wtext)
     on_2deg = ("with the grid's best" if climbs_2deg(s["grid_slope2deg"])
                else "on the default gait (no grid point climbs)")
     for name, label in (("slope", "Slope story, 0.02 rad (Figs. 8–9)"),
@@ -345,6 +419,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     for name in fl:
         lines += [embed(_read(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
                   f"![Floquet multipliers, {name}](floquet/{name}/floquet.png)", ""]
+    if "dynamics" in s:
+        lines += dynamics_section(out, s["dynamics"], wtext)
     g2 = s["grid_slope2deg"]
     lines += [
         "## Slopes (Figs. 8–11, Table VII)",

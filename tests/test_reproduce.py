@@ -99,12 +99,12 @@ SMOKE = Profile("smoke", distance_m=5.0, grid_points=1, grid_initiation_points=1
                 learn_variant=(1, 2), window_step_s=0.4, stability_trials=1, jacobian=False,
                 margin_force_step_n=50.0, slope=(1, 1), slope_grid_full=False, time_steps=(0.0005, 0.001),
                 time_step_distance_m=2.0, expected_minutes=1.0, floquet_epsilons=(1e-6, 1e-5, 1e-4),
-                floquet_newton_iterations=2)
+                floquet_newton_iterations=2, dynamics=(2, 2, 2), dynamics_walks_m=(5.0, 5.0, 4.0, 4.0))
 
 SECTIONS = ("## The walk", "## Grid search, Table IV", "## Table III as printed", "## Torque-free windows",
             "## Experiment 1", "## Learners side by side", "### Table V", "### Exploration matched",
             "## Pushes and return maps", "Table VI", "### Push margins",
-            "### The periodic orbit and its Floquet multipliers", "## Slopes", "### The slope story, Figs. 8–9",
+            "### The periodic orbit and its Floquet multipliers", "## The gait as a dynamical system", "## Slopes", "### The slope story, Figs. 8–9",
             "### Table VII", "### The slope story, Figs. 10–11", "## Time step", "## Other gaits, and why each exists")
 
 
@@ -120,12 +120,14 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for heading in SECTIONS:
         assert heading in text, heading
     table = [line for line in text.splitlines() if line.startswith("| ") and "**" in line]
-    assert len(table) == 13
+    assert len(table) == 16
     for row in table:  # every verdict row holds a measured number and a verdict
         ours = row.split(" | ")[2]
         assert re.search(r"\d", ours), row
     for figure in ("report_summary.png", "walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
-                   "compare_learners/compare.png", "floquet/none/floquet.png", "slope/fig8_period.png", "slope2deg/fig9_distance.png", "grid/grid_slices.png"):
+                   "compare_learners/compare.png", "floquet/none/floquet.png", "slope/fig8_period.png",
+                   "slope2deg/fig9_distance.png", "grid/grid_slices.png", "dynamics/t1/bifurcation.png",
+                   "dynamics/basins/basins.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
     # The Floquet row says of each orbit whether its multipliers establish anything.
     from drake_biped.analysis.floquet import record_verdict

@@ -32,7 +32,7 @@ from drake_biped.params import EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["BasinSettings", "basins", "run", "markdown"]
+__all__ = ["BasinSettings", "basins", "markdown", "reading", "run"]
 
 MAX_WALKS = 800
 
@@ -103,7 +103,7 @@ def basins(settings: BasinSettings, out: Path, client, progress=None) -> dict[st
             "jitter_tolerance_s": JITTER_TOLERANCE_S, "grids": grids}
 
 
-def _kind(cell: dict) -> str:
+def reading(cell: dict) -> str:
     """A cell's reading for the figure: the strict label, else the jitter-scale one."""
     if cell["fell"]:
         return "falls"
@@ -122,8 +122,8 @@ def markdown(record: dict[str, Any]) -> str:
              "| condition | attractor | starts | mean step period (s) | long-run C_mt |", "|---|---|---|---|---|"]
     for condition, grid in record["grids"].items():
         cells = [c for row in grid for c in row]
-        for kind in sorted({_kind(c) for c in cells}):
-            group = [c for c in cells if _kind(c) == kind]
+        for kind in sorted({reading(c) for c in cells}):
+            group = [c for c in cells if reading(c) == kind]
             periods = [c["step_period_mean_s"] for c in group if c["step_period_mean_s"] is not None and not c["fell"]]
             costs = [c["cost_of_transport"] for c in group if c["cost_of_transport"] is not None]
             lines.append(f"| {condition} | {kind} | {len(group)} | "
@@ -155,7 +155,7 @@ def figure(record: dict[str, Any], path: Path) -> None:
                     continue
                 scatter = ax.scatter(speed, angle, c=[c["step_period_mean_s"]], cmap="viridis", vmin=vmin, vmax=vmax,
                                      s=90, marker="s")
-                if not _kind(c).startswith("period-"):
+                if not reading(c).startswith("period-"):
                     ax.scatter(speed, angle, s=160, facecolors="none", edgecolors="r", linewidths=1.2)
         ax.set_title(f"{condition} the window", fontsize=9)
         ax.set_xlabel("initiation speed (m/s)")

@@ -47,6 +47,7 @@ from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import (
     PAPER_CPG,
     EpisodeConfig,
+    Ground,
     InitialConditions,
     ParameterError,
     TorqueFreeWindow,
@@ -93,6 +94,11 @@ class Profile:
     floquet_gaits: tuple[str, ...] = ("none", "learned")  # whose orbits: no window, the learned window
     steps: tuple[str, ...] = ()  # the steps run, in Reproduction.STEPS' order (empty: all of them)
     rewalk_distance_m: float = 10.0  # learned windows re-walked this far (110: a long-run mean after 10 m)
+    # The dynamics step: values of t1 in the bifurcation over it, slopes in each slope sweep, starts per axis of
+    # the basins' slice; and its walks' lengths (m): the attractors, the sweeps over t1 and the Table III walker,
+    # the slopes (2 m level included), the basins
+    dynamics: tuple[int, int, int] = (9, 12, 5)
+    dynamics_walks_m: tuple[float, float, float, float] = (110.0, 60.0, 32.0, 30.0)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -408,6 +414,66 @@ class Reproduction:
         return self.experiment("floquet", {"windows": {k: list(v) for k, v in windows.items()},
                                            "distance_m": self.profile.distance_m}, run)
 
+    def dynamics(self) -> dict:
+        """The gait as a dynamical system (`bifurcation`, `basins`): what the walk settles on without a window
+        and with the learned one (110 m); a bifurcation over t1 (the learned t2 kept, 60 m walks); the steepest
+        slope climbed for 30 m after 2 m level without and with the learned window, and the paper's slope
+        premise between them; the Table III walker under the entrained reading (`paper_entrained`) at the shipped
+        step and half of it; and a slice of starts, without and with the learned window."""
+        from drake_biped.experiments import basins, bifurcation
+
+        n_t1, n_slopes, n_starts = self.profile.dynamics
+        long_m, sweep_m, slope_m, basin_m = self.profile.dynamics_walks_m
+        window, source, _ = self.learned_window()
+        learned = TorqueFreeWindow(*window)
+        settings = {"window": list(window), "dynamics": [n_t1, n_slopes, n_starts],
+                    "walks_m": [long_m, sweep_m, slope_m, basin_m]}
+
+        def sweep(folder: Path, config: EpisodeConfig, param: str, values, distance: float, **kw) -> dict:
+            config = config.override({"sim.distance_m": distance, "sim.max_time_s": 6.0 * distance})
+            kw.setdefault("transient_m", min(bifurcation.TRANSIENT_M, 0.4 * distance))
+            return bifurcation.run(bifurcation.BifurcationSettings(config, param, tuple(values), **kw), folder,
+                                   self._client, progress=False)
+
+        def run(folder: Path) -> dict:
+            import numpy as np
+
+            level = EpisodeConfig().replace(window=learned)
+            walks = sweep(folder / "learned", level, "t2", (0.0, window[1]), long_m)  # t2 0: no window
+            t1 = sweep(folder / "t1", level, "t1", np.linspace(0.30, 0.46, n_t1), sweep_m)
+            up = EpisodeConfig().replace(ground=Ground(slope_rad=0.0, level_length_m=2.0))
+            slopes = np.round(np.linspace(0.005, 0.005 * n_slopes, n_slopes), 4)
+            slope = {name: sweep(folder / f"slope_{name}", up.replace(window=w), "slope", slopes, slope_m,
+                                 transient_m=2.0, lyapunov=False)
+                     for name, w in (("without", TorqueFreeWindow()), ("with", learned))}
+            entrained = load_gait("paper_entrained")
+            paper = sweep(folder / "paper_entrained", entrained, "speed", (entrained.initial.speed_mps,), sweep_m,
+                          second_time_step_s=0.5 * entrained.sim.time_step_s)
+            slice_ = basins.run(basins.BasinSettings(
+                EpisodeConfig().override({"sim.distance_m": basin_m, "sim.max_time_s": 6.0 * basin_m}), window,
+                tuple(np.round(np.linspace(0.10, 0.16, n_starts), 4)),
+                tuple(np.round(np.linspace(0.14, 0.21, n_starts), 4)),
+                transient_m=min(bifurcation.TRANSIENT_M, 0.4 * basin_m)), folder / "basins", self._client,
+                progress=False)
+
+            def brief(point: dict) -> dict:
+                keys = ("value", "time_step_s", "fell", "attractor", "within_jitter", "lyapunov", "cost_of_transport",
+                        "interval_95", "spread_s")
+                return {k: point.get(k) for k in keys}
+
+            return {"window_source": source, "learned": [brief(p) for p in walks["points"]],
+                    "t1": [brief(p) for p in t1["points"]],
+                    "slope": {name: {"walked_up_to": r["walked_up_to"], "fell": [p["value"] for p in r["points"]
+                                                                                 if p["fell"]]}
+                              for name, r in slope.items()},
+                    "premise": bifurcation.premise(slope["without"]["points"], slope["with"]["points"]),
+                    "paper_entrained": [brief(p) for p in paper["points"]],
+                    "basins": {"hip_angles_rad": slice_["hip_angles_rad"], "speeds_mps": slice_["speeds_mps"],
+                               **{c: [[basins.reading(cell) for cell in row] for row in g]
+                                  for c, g in slice_["grids"].items()}}}
+
+        return self.experiment("dynamics", settings, run)
+
     def slope_axes(self) -> list:
         """The 2.0 deg grid's axes around the default gait (SLOPE_2DEG_*): its torso leaned further forward, a
         larger placement gain, and u_a, u_r, kappa raised as in Table VII; or the 2 x 2 corner of lean and u_a."""
@@ -476,8 +542,8 @@ class Reproduction:
 
     # The paper's claims first; the learners side by side, beyond the paper and the costliest step, last.
     STEPS = ("walk", "time_step", "grid", "table_iii", "paper_gait", "full_run", "window_map", "learn",
-             "learn_variant", "stability", "push_margin", "floquet", "grid_slope2deg", "slope", "slope2deg",
-             "compare_learners")
+             "learn_variant", "stability", "push_margin", "floquet", "dynamics", "grid_slope2deg", "slope",
+             "slope2deg", "compare_learners")
 
     def run_all(self) -> dict[str, dict]:
         self.out.mkdir(parents=True, exist_ok=True)
