@@ -98,11 +98,12 @@ RESUMABLE = ("gait-search", "learn", "compare-learners", "stability", "grid", "s
 
 # The experiments with a command of their own, in the order `drake-biped --help` lists them.
 EXPERIMENT_COMMANDS = ("walk", "window_map", "gait_search", "time_step", "learning", "compare_learners", "landscape",
-                       "stability", "rewalk", "floquet", "bifurcation", "basins", "push_margin", "grid", "slope", "reproduce")
+                       "stability", "rewalk", "floquet", "bifurcation", "basins", "push_margin", "grid", "slope",
+                       "reproduce")
 
 
 def experiment_commands() -> list:
-    """The experiment modules that own a command (COMMAND, PARSER, add_arguments, command)."""
+    """The experiment modules that own a command (COMMAND, PARSER, add_arguments, settings_from_args, command)."""
     import importlib
 
     return [importlib.import_module(f"drake_biped.experiments.{name}") for name in EXPERIMENT_COMMANDS]

@@ -93,3 +93,20 @@ def test_cli_rejects_bad_input(argv, needle, capsys, tmp_path):
     assert exc.value.code == 2
     assert needle in capsys.readouterr().err
     assert not (tmp_path / "out" / "result.json").exists()
+
+
+def test_every_experiment_owns_its_command_in_one_shape():
+    """Each experiment module declares its options, builds its settings from them, runs, and is the one place
+    its command is defined; cli.py only loops over them."""
+    import inspect
+
+    from drake_biped import cli
+
+    names = set()
+    for module in cli.experiment_commands():
+        for attr in ("COMMAND", "PARSER", "add_arguments", "settings_from_args", "command", "run"):
+            assert hasattr(module, attr), (module.__name__, attr)
+        assert list(inspect.signature(module.settings_from_args).parameters) == ["args"], module.__name__
+        names.add(module.COMMAND)
+    commands = next(a for a in cli.build_parser()._actions if a.dest == "command").choices
+    assert names <= set(commands) and {"bifurcation", "basins"} <= names

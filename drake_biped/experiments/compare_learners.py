@@ -186,11 +186,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
+def settings_from_args(args: argparse.Namespace) -> CompareSettings:
+    """The comparison's settings from the command's options."""
+    return CompareSettings(episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
+                           episodes=args.episodes, seed=args.seed if args.seed is not None else 0)
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = CompareSettings(
-        episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
-        episodes=args.episodes, seed=args.seed if args.seed is not None else 0)
+    settings = settings_from_args(args)
     out = Path(args.out)
     check(settings, out)  # before a cluster starts
     with cluster(args) as client:

@@ -371,15 +371,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+def settings_from_args(args: argparse.Namespace) -> FloquetSettings:
+    """The analysis's settings from the command's options: the gait's window, or --t1/--t2 or --policy."""
     from drake_biped.params import TorqueFreeWindow
 
     config = episode_config(args)
     if args.policy is not None or args.t1 is not None or args.t2 is not None:
         config = config.replace(window=TorqueFreeWindow(*chosen_window(args)))
-    settings = FloquetSettings(config, settle_steps=args.settle_steps,
-                                       **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}))
+    return FloquetSettings(config, settle_steps=args.settle_steps,
+                           **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}))
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = settings_from_args(args)
     out = Path(args.out)
     with cluster(args) as client:
         record = run(settings, out, client)

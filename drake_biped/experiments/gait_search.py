@@ -769,13 +769,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+def settings_from_args(args: argparse.Namespace) -> GaitSearchSettings:
+    """The search's settings from the command's options."""
     config = episode_config(args)
-    settings = GaitSearchSettings(
+    return GaitSearchSettings(
         config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
         distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
         objective=args.objective, policy_draws=args.policy_draws)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = settings_from_args(args)
     search = run_cmaes if args.method == "cmaes" else run
     with cluster(args) as client:
         result = search(settings, Path(args.out), client)

@@ -367,17 +367,22 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.progress import check_run_log
-
+def settings_from_args(args: argparse.Namespace) -> GridSettings:
+    """The grid's settings from the command's options, its size checked before anything is built."""
     config = episode_config(args)
     if args.spec is not None and args.points_per_axis is not None:
         raise ParameterError("give either --spec or --points-per-axis, not both")
     axes = load_spec(args.spec) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
     source = f"--spec {args.spec}" if args.spec is not None else f"--points-per-axis {args.points_per_axis or 2}"
-    check_size(axes, args.force, source, "--force")  # before anything is built or started
-    settings = GridSettings(config, tuple(axes), force=args.force)
+    check_size(axes, args.force, source, "--force")
+    return GridSettings(config, tuple(axes), force=args.force)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.experiments.progress import check_run_log
+
+    settings = settings_from_args(args)
     out = Path(args.out)
     check_run_log(out, "grid")  # before a cluster starts
     with cluster(args) as client:

@@ -92,11 +92,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default=None, type=out_folder, help="output folder (default: the window map's)")
 
 
+def settings_from_args(args: argparse.Namespace) -> LandscapeSettings:
+    """The landscape's settings from the command's options."""
+    return LandscapeSettings(args.window_map, tuple(args.variance),
+                             (tuple(args.start),) if args.start else ((0.5, 0.5),), samples=args.samples,
+                             seed=args.seed)
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = LandscapeSettings(args.window_map, tuple(args.variance),
-                                           (tuple(args.start),) if args.start else ((0.5, 0.5),),
-                                           samples=args.samples, seed=args.seed)
+    settings = settings_from_args(args)
     record = run(settings, Path(args.out) if args.out else None)
     print_lines(summary_lines(record))
     out = Path(args.out) if args.out else settings.path().parent

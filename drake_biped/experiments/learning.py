@@ -510,16 +510,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
+def settings_from_args(args: argparse.Namespace) -> LearningSettings:
+    """The learning run's settings from the command's options."""
+    return LearningSettings(episode_config(args), args.trials, args.episodes, args.seed if args.seed is not None else 0,
+                            mean=tuple(args.initial_mean), variance=args.variance, learner=args.learner)
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     from drake_biped.experiments.progress import check_run_log
 
-    config = episode_config(args)
-    settings = LearningSettings(config, args.trials, args.episodes,
-                                         args.seed if args.seed is not None else 0,
-                                         mean=tuple(args.initial_mean), variance=args.variance,
-                                         learner=args.learner)
-    record_settings = settings.record()  # validated before a cluster starts
+    record_settings = settings_from_args(args).record()  # validated before a cluster starts
     out = Path(args.out)
     check_resume(record_settings, out)
     check_run_log(out, "learn")  # before a cluster starts

@@ -266,14 +266,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+def settings_from_args(args: argparse.Namespace) -> PushMarginSettings:
+    """The map's settings from the command's options: 12 m walks unless --distance."""
     config = episode_config(args)
     if args.distance is None:  # a push at --settle s (about 6 m), then room to recover or fall
         config = config.override({"sim.distance_m": 12.0, "sim.max_time_s": max(config.sim.max_time_s, 72.0)})
-    settings = PushMarginSettings(config, chosen_window(args), max_force_n=args.max_force,
-                                              force_step_n=args.force_step, phases=args.phases,
-                                              settle_s=args.settle, force=args.force)
+    return PushMarginSettings(config, chosen_window(args), max_force_n=args.max_force, force_step_n=args.force_step,
+                              phases=args.phases, settle_s=args.settle, force=args.force)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = settings_from_args(args)
     out = Path(args.out)
     with cluster(args) as client:
         run(settings, out, client)

@@ -637,10 +637,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
+def settings_from_args(args: argparse.Namespace) -> ReproduceSettings:
+    """The reproduction's settings from the command's options: the quick or the full profile."""
+    return ReproduceSettings(QUICK if args.quick else FULL)
+
+
 def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     from drake_biped.experiments.executor import check_cluster_options
 
-    profile = QUICK if args.quick else FULL
+    settings = settings_from_args(args)
+    profile = settings.profile
     out = Path(args.out)
     check_cluster_options(args.workers, args.scheduler, args.force)  # before the folder is claimed for this profile
     check_out(out, profile)
@@ -649,8 +656,7 @@ def command(args: argparse.Namespace) -> int:
           "about " + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
           + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
     with cluster(args) as client:
-        run(ReproduceSettings(profile), out, client, workers=args.workers,
-                      scheduler=args.scheduler)
+        run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines()[:40] if line.startswith("|")))
     print(f"wrote {out}/report.md, report.html")
     return 0

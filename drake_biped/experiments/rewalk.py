@@ -145,16 +145,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
 
 
+def settings_from_args(args: argparse.Namespace) -> RewalkSettings:
+    """The re-walks' settings from the command's options; what is not a learning record is refused here,
+    before a cluster starts."""
+    from drake_biped.records import read_json
+
+    check_learning_record(read_json(Path(args.policy), "--policy"), f"--policy {args.policy}")
+    return RewalkSettings(Path(args.policy))
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     from drake_biped.analysis.rewalks import markdown
-    from drake_biped.records import read_json
 
-    # What is not a learning record is refused before a cluster starts.
-    check_learning_record(read_json(Path(args.policy), "--policy"), f"--policy {args.policy}")
+    settings = settings_from_args(args)
     out = Path(args.out)
     with cluster(args) as client:
-        record = run(RewalkSettings(Path(args.policy)), out, client)
+        record = run(settings, out, client)
     print(markdown(record))
     print(f"wrote {out}/rewalk.json, rewalk.md")
     return 0

@@ -342,10 +342,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.progress import check_run_log
-
+def settings_from_args(args: argparse.Namespace) -> SlopeSettings:
+    """The slope story's settings from the command's options; a --policy that cannot be read is refused
+    here, before a cluster starts."""
     level = args.level_length
     args.level_length = None  # the slope ground is built by the slope settings, not by the episode options
     slope_rad, args.slope = args.slope, None
@@ -360,7 +359,15 @@ def command(args: argparse.Namespace) -> int:
         settings = SlopeSettings(config, slope_rad, level, window=chosen_window(args),
                                        variance=args.variance, trials=args.trials, episodes=args.episodes,
                                        seed=config.seed)
-    settings.start()  # a --policy that cannot be read is refused before a cluster starts
+    settings.start()
+    return settings
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    from drake_biped.experiments.progress import check_run_log
+
+    settings = settings_from_args(args)
     out = Path(args.out)
     check_run_log(out, "slope")
     with cluster(args) as client:

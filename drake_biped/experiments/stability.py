@@ -394,11 +394,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_resumable_run_options(p)
 
 
+def settings_from_args(args: argparse.Namespace) -> StabilitySettings:
+    """The stability study's settings from the command's options."""
+    config = episode_config(args)
+    return StabilitySettings(window=chosen_window(args), trials=args.trials, push_force_n=args.push,
+                             spread=args.spread, seed=config.seed, config=config, floquet=args.floquet)
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    config = episode_config(args)
-    settings = StabilitySettings(window=chosen_window(args), trials=args.trials, push_force_n=args.push,
-                                 spread=args.spread, seed=config.seed, config=config, floquet=args.floquet)
+    settings = settings_from_args(args)
     out = Path(args.out)
     with cluster(args) as client:
         run(settings, out, client)

@@ -373,21 +373,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
 
 
+def settings_from_args(args: argparse.Namespace) -> TimeStepSettings:
+    """The study's settings from the command's options."""
+    from drake_biped.resources import load_gait
+
+    config = None if args.params is None else load_gait(args.params)
+    if args.model is not None:
+        config = with_model(config or EpisodeConfig(), args.model)
+    reference = min(args.steps) if args.reference is None else args.reference
+    return TimeStepSettings(tuple(args.steps), reference, args.distance, config,
+                            "Default gait" if args.params is None else f"Gait {args.params}",
+                            None if args.windows is None else tuple(args.windows))
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     out = Path(args.out)
     if args.replot:
         rec = replot(out)
     else:
-        from drake_biped.resources import load_gait
-
-        config = None if args.params is None else load_gait(args.params)
-        if args.model is not None:
-            config = with_model(config or EpisodeConfig(), args.model)
-        reference = min(args.steps) if args.reference is None else args.reference
-        settings = TimeStepSettings(tuple(args.steps), reference, args.distance, config,
-                                              "Default gait" if args.params is None else f"Gait {args.params}",
-                                              None if args.windows is None else tuple(args.windows))
+        settings = settings_from_args(args)
         with cluster(args) as client:
             rec = run(settings, out, client)
     print((out / "time_step_study.md").read_text())

@@ -232,8 +232,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+def settings_from_args(args: argparse.Namespace) -> WalkSettings:
+    """The walk's settings from the command's options."""
     config = episode_config(args)
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
@@ -246,9 +246,15 @@ def command(args: argparse.Namespace) -> int:
         config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
     elif args.push_start != 0.4 or args.push_duration != 0.1:
         raise ParameterError("--push-start and --push-duration shape a push: give --push N too")
+    return WalkSettings(config, animation=not args.no_animation, save_trajectory=args.save_trajectory)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run the command of `args` (its options parsed by add_arguments); the exit code."""
+    settings = settings_from_args(args)
+    config = settings.config
     out = Path(args.out)
-    result = run(WalkSettings(config, animation=not args.no_animation,
-                                        save_trajectory=args.save_trajectory), out)
+    result = run(settings, out)
     print_lines(summary_lines(result))
     if not args.no_animation:
         print_lines(animation_lines(out))

@@ -219,10 +219,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
 
 
+def settings_from_args(args: argparse.Namespace) -> WindowMapSettings:
+    """The map's settings from the command's options."""
+    return WindowMapSettings(episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
+                             t1_step_s=args.step, t2_step_s=args.step, force=args.force)
+
+
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = WindowMapSettings(episode_config(args), t1_max_s=args.t1_max, t2_max_s=args.t2_max,
-                                            t1_step_s=args.step, t2_step_s=args.step, force=args.force)
+    settings = settings_from_args(args)
     with cluster(args) as client:
         record = run(settings, Path(args.out), client)
     print_lines(summary_lines(record))
