@@ -8,7 +8,7 @@ the shipped gaits were found: "steady" (the first default) from a walker of an e
 
 Score of a configuration that does not walk `distance_m` without a window: -9 + 8 * (the fraction of the
 distance it walked), so that a search from a gait that falls climbs towards one that walks (the "robust",
-"story", "hold" and "hold-long" objectives score fallers themselves). Of one that walks, by the objective:
+"story", "hold", "hold-long" and "hold-step" objectives score fallers themselves). Of one that walks, by the objective:
 OBJECTIVES, one entry per objective with its scoring function and what it scores (`drake-biped
 gait-search --help` prints them).
 
