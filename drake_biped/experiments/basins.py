@@ -17,7 +17,7 @@ import numpy as np
 
 from drake_biped.analysis.attractor import step_period_label
 from drake_biped.analysis.long_run import TRANSIENT_M
-from drake_biped.experiments.bifurcation import JITTER_TOLERANCE_S, attractor_of_walk
+from drake_biped.experiments.bifurcation import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
 from drake_biped.experiments.options import (
     add_cluster_options,
     add_episode_options,
@@ -91,7 +91,8 @@ def basins(settings: BasinSettings, out: Path, client, progress=None) -> dict[st
             for j in range(len(settings.speeds_mps)):
                 label = attractor_of_walk(results[(condition, i, j)], distance, settings.transient_m)
                 periods = label["step_periods_s"][-20:]
-                coarse = step_period_label(label["step_periods_s"], fell=label["fell"], tolerance_s=JITTER_TOLERANCE_S)
+                coarse = step_period_label(label["step_periods_s"], fell=label["fell"], tolerance_s=JITTER_TOLERANCE_S,
+                                           max_period=JITTER_MAX_PERIOD)
                 row.append({"attractor": label["attractor"], "within_jitter": coarse["attractor"],
                             "fell": label["fell"], "distance_m": label["distance_m"],
                             "step_period_mean_s": float(np.mean(periods)) if periods else None,

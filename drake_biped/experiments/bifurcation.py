@@ -9,7 +9,7 @@ the simplest walker's period doubling this way.
 The 1 kHz controller sees a touchdown only at its next update, so even a regular gait's step periods jitter by a
 few milliseconds (the full-state section map is discontinuous on that scale, which leaves Newton's method and
 central-difference multipliers without a meaning there). Each point is therefore also read at the jitter's
-scale (period-k to within `jitter_tolerance_s`), and an irregular walk gets a finite-size Lyapunov exponent: a
+scale (period 1 or 2 to within `jitter_tolerance_s`), and an irregular walk gets a finite-size Lyapunov exponent: a
 neighbour walk, its swing hip's rate kicked by NEIGHBOUR_KICK_RADPS early in the first step after the
 transient, and the rate at which their sections part (`attractor.lyapunov_from_neighbours`) until they are half
 the attractor's size apart. A second plant step may be given to show what the discretisation does. Walks are
@@ -52,8 +52,10 @@ __all__ = ["BifurcationSettings", "attractor_of_walk", "markdown", "premise", "r
 # At most this many walks without --force.
 MAX_WALKS = 400
 # The step periods of a regular gait jitter by a few ms (the controller sees a touchdown at its next update):
-# the tolerance of the reading at that scale.
+# the tolerance of the reading at that scale, and the longest period it names (every k-th of 20 periods is too
+# few to tell a period-4 at 10 ms from an irregular walk).
 JITTER_TOLERANCE_S = 0.01
+JITTER_MAX_PERIOD = 2
 # The neighbour walk of an irregular one: its swing hip's rate kicked by this much (rad/s), this long after the
 # first kept touchdown (the swing foot in the air); their sections' distance followed until it reaches this
 # fraction of the attractor's spread.
@@ -196,7 +198,7 @@ def bifurcation(settings: BifurcationSettings, out: Path, client, progress=None)
             point = {"value": float(value), "time_step_s": h,
                      **attractor_of_walk(walk, distance, settings.transient_m)}
             jittered = step_period_label(point["step_periods_s"], fell=point["fell"],
-                                         tolerance_s=settings.jitter_tolerance_s)
+                                         tolerance_s=settings.jitter_tolerance_s, max_period=JITTER_MAX_PERIOD)
             point["within_jitter"] = {"attractor": jittered["attractor"], "period": jittered["period"],
                                       "tolerance_s": settings.jitter_tolerance_s}
             point["lyapunov"] = None
@@ -273,8 +275,12 @@ def figure(record: dict[str, Any], path: Path) -> None:
             ax.plot(fell, [ax.get_ylim()[0]] * len(fell), marker="v", color="k", ls="", label="falls")
     for p in record["points"]:
         if p["time_step_s"] == record["time_steps_s"][0]:
-            top.annotate(p["attractor"].replace("period-", "P"), (p["value"], 1.0), xycoords=("data", "axes fraction"),
-                         ha="center", va="bottom", fontsize=7)
+            text = p["attractor"].replace("period-", "P")
+            jitter = (p.get("within_jitter") or {}).get("attractor", "")
+            if jitter.startswith("period-") and jitter != p["attractor"]:
+                text += f"\n{jitter.replace('period-', 'P')} at {1e3 * record['jitter_tolerance_s']:g} ms"
+            top.annotate(text, (p["value"], 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
+                         fontsize=7)
     top.set_ylabel("step period (s)")
     bottom.set_ylabel("hip angle at touchdown (rad)")
     bottom.set_xlabel(record["param"])
