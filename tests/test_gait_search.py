@@ -345,3 +345,30 @@ def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatc
     gains = [1 / (1 - min(saving(t1, False), saving(t1, True))) - 1 for t1 in t1s]
     d = gait_search.distance_from_table_iii(config.cpg)
     assert value == pytest.approx(least + 0.1 * sum(gains) / len(gains) - 0.01 * d / (1.0 + d))
+
+
+def test_hold_step_places_windows_by_the_gaits_step_and_subtracts_the_lure(monkeypatch):
+    """Fake walks: a 0.42 s powered step, every window below it saving 40 % long-run under every change, and a
+    10 m episode past the step saving 25 % (t1 0.435) and 10 % (t1 0.46): score = 0.40 - 0.25 + 0.1 x 0.40."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_robust_score", lambda config, b: (0.0, {"checks": {}}))
+    seen = []
+
+    def long_walk(config):
+        if config.window.end_s <= config.window.start_s:
+            return {"walked": True, "cost_of_transport": 0.6, "step_period_s": 0.42}
+        seen.append(round(config.window.start_s, 4))
+        return {"walked": True, "cost_of_transport": 0.36, "step_period_s": 0.5}
+
+    def walk(config):
+        saving = {0.435: 0.25, 0.46: 0.10}[round(config.window.start_s, 3)]
+        return {"walked": True, "cost_of_transport": 0.5 * (1 - saving), "distance_m": 10.0}
+
+    monkeypatch.setattr(gait_search, "_long_walk", long_walk)
+    monkeypatch.setattr(gait_search, "_walk", walk)
+    config = EpisodeConfig().replace(cpg=PAPER_CPG)
+    value, detail = gait_search.OBJECTIVES["hold-step"].score(config, base, (), 0)
+    assert sorted(set(seen)) == [0.34, 0.38, 0.405]  # T - 0.08, T - 0.04, T - 0.015, each under 4 changes
+    assert len(seen) == 12
+    assert detail["past_step_saving"] == pytest.approx(0.25) and detail["least_saving"] == pytest.approx(0.4)
+    assert value == pytest.approx(0.40 - 0.25 + 0.04)  # Table III's CPG: no distance term

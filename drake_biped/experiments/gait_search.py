@@ -346,8 +346,11 @@ def _long_walk(config: EpisodeConfig) -> dict[str, Any]:
             "step_period_std_s": long_run["step_period_std_s"]}
 
 
-def _hold_long_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
-    """The "hold-long" objective (module docstring) and what it measured; `base` may be a fall."""
+def _long_windows(config: EpisodeConfig, base: dict[str, Any], windows_of) -> tuple[float | None, dict[str, Any]]:
+    """What "hold-long" and "hold-step" share: the "robust" objective first, then HOLD_LONG_M walks without a
+    window as it is, at half the plant step and from 0.95 / 1.05 x the initiation speed, and the same walks with
+    each window of `windows_of(bases)`, each saving against no window under the same change. (score, detail)
+    when a check fails first; else (None, detail with "long_bases", "windows" and "savings")."""
     robust, detail = _robust_score(config, base)
     if robust < 0.0:
         return robust - 2.0, detail
@@ -357,44 +360,42 @@ def _hold_long_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
         walked = sum(b["walked"] for b in bases.values())
         return -1.5 + 0.1 * walked, {**detail, "long_bases": bases}
     windows = []
-    for t1, t2 in HOLD_LONG_WINDOWS:
+    for t1, t2 in windows_of(bases):
         walks = {name: _long_walk(c.replace(window=TorqueFreeWindow(t1, t2))) for name, c in changed.items()}
         windows.append({"window": [t1, t2], "walks": walks,
                         "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
     savings = [v for w in windows for v in w["savings"].values()]
+    return None, {**detail, "long_bases": bases, "windows": windows, "savings": savings}
+
+
+def _hold_long_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-long" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    early, detail = _long_windows(config, base, lambda bases: HOLD_LONG_WINDOWS)
+    if early is not None:
+        return early, detail
+    savings = detail.pop("savings")
     least = min(savings)
     d = distance_from_table_iii(config.cpg)
     value = least + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
-    return value, {**detail, "long_bases": bases, "windows": windows, "least_saving": least,
-                   "distance_from_table_iii": d}
+    return value, {**detail, "least_saving": least, "distance_from_table_iii": d}
 
 
 def _hold_step_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
     """The "hold-step" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
-    robust, detail = _robust_score(config, base)
-    if robust < 0.0:
-        return robust - 2.0, detail
-    changed = {"as_is": config, **_changed(config)}
-    bases = {name: _long_walk(c.replace(window=TorqueFreeWindow())) for name, c in changed.items()}
-    if not all(b["walked"] for b in bases.values()):
-        walked = sum(b["walked"] for b in bases.values())
-        return -1.5 + 0.1 * walked, {**detail, "long_bases": bases}
-    period = bases["as_is"]["step_period_s"]
-    windows = []
-    for below in HOLD_STEP_BELOW_S:
-        t1 = round(period - below, 4)
-        walks = {name: _long_walk(c.replace(window=TorqueFreeWindow(t1, 1.2))) for name, c in changed.items()}
-        windows.append({"window": [t1, 1.2], "walks": walks,
-                        "savings": {name: _saving(w, bases[name]) for name, w in walks.items()}})
-    savings = [v for w in windows for v in w["savings"].values()]
+    early, detail = _long_windows(config, base, lambda bases: [
+        (round(bases["as_is"]["step_period_s"] - below, 4), 1.2) for below in HOLD_STEP_BELOW_S])
+    if early is not None:
+        return early, detail
+    savings = detail.pop("savings")
+    period = detail["long_bases"]["as_is"]["step_period_s"]
     past = [{"window": [round(period + s, 4), 1.2],
              **_walk(config.replace(window=TorqueFreeWindow(round(period + s, 4), 1.2)))} for s in HOLD_STEP_PAST_S]
     lure = max([0.0, *(_saving(row, base) for row in past if row["walked"])])
     least = min(savings)
     d = distance_from_table_iii(config.cpg)
     value = least - lure + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
-    return value, {**detail, "long_bases": bases, "windows": windows, "past_step": past, "least_saving": least,
-                   "past_step_saving": lure, "step_period_s": period, "distance_from_table_iii": d}
+    return value, {**detail, "past_step": past, "least_saving": least, "past_step_saving": lure,
+                   "step_period_s": period, "distance_from_table_iii": d}
 
 
 Score = Callable[[EpisodeConfig, dict[str, Any], Any, int], tuple[float, dict[str, Any]]]
