@@ -27,7 +27,9 @@ def step_period_label(periods_s: Sequence[float], fell: bool = False, window: in
     """The attractor a walk's step periods show: {"attractor": "fell" | "period-k" | "irregular" |
     "too short", "period": k or None, "spread_s": the last `window` periods' max - min}. Period-k: the smallest
     k for which, among the last max(window, 3 k) periods, every k-th one (T_j, T_(j+k), T_(j+2k), ...) varies
-    by less than tolerance_s (period-1: the last `window` periods vary by less than tolerance_s)."""
+    by less than tolerance_s, and (k > 1) the k points of the orbit, those sequences' means, lie at least
+    tolerance_s apart (period-1: the last `window` periods vary by less than tolerance_s). Without that second
+    condition a period-1 walk jittering by a little more than tolerance_s passes for period-k by chance."""
     t = np.asarray(periods_s, dtype=float)
     if fell:
         return {"attractor": "fell", "period": None, "spread_s": None}
@@ -37,7 +39,8 @@ def step_period_label(periods_s: Sequence[float], fell: bool = False, window: in
     spread = float(last.max() - last.min())
     for k in range(1, max_period + 1):
         tail = t[-max(window, 3 * k):]
-        if all(np.ptp(tail[r::k]) < tolerance_s for r in range(k)):
+        if all(np.ptp(tail[r::k]) < tolerance_s for r in range(k)) and (
+                k == 1 or np.ptp([tail[r::k].mean() for r in range(k)]) >= tolerance_s):
             return {"attractor": f"period-{k}", "period": k, "spread_s": spread}
     return {"attractor": "irregular", "period": None, "spread_s": spread}
 
