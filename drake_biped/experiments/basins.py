@@ -173,24 +173,12 @@ def run(settings: BasinSettings, out: Path, client=None, progress: bool = True) 
     (the walks kept in out/walks). The record."""
     check_settings(settings, BasinSettings, "basins.run")
     from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import progress_bar
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=settings.walks, desc="basins", unit="walk")
-
-    def tick(done: int, total: int) -> None:
-        if bar is not None:
-            bar.n = done
-            bar.refresh()
-
-    with client_or_local(client) as c:
+    with progress_bar(settings.walks, "basins", "walk", progress) as tick, client_or_local(client) as c:
         record = basins(settings, out, c, tick)
-    if bar is not None:
-        bar.close()
     record.update(config=settings.config.to_dict(), versions=versions())
     write_atomic(out / "basins.json", record)
     write_text_atomic(out / "basins.md", markdown(record))

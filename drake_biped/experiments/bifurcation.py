@@ -297,25 +297,12 @@ def run(settings: BifurcationSettings, out: Path, client=None, progress: bool = 
     bifurcation.png into `out` (the walks and orbits kept in out/walks and out/orbits). The record."""
     check_settings(settings, BifurcationSettings, "bifurcation.run")
     from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import progress_bar
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(settings.values) * len(settings.time_steps), desc="bifurcation", unit="walk")
-
-    def tick(done: int, total: int) -> None:
-        if bar is not None:
-            bar.total = max(bar.total, total)
-            bar.n = done
-            bar.refresh()
-
-    with client_or_local(client) as c:
+    with progress_bar(len(settings.values) * len(settings.time_steps), "bifurcation", "walk", progress) as tick, client_or_local(client) as c:
         record = bifurcation(settings, out, c, tick)
-    if bar is not None:
-        bar.close()
     record.update(config=settings.config.to_dict(), versions=versions())
     write_atomic(out / "bifurcation.json", record)
     write_text_atomic(out / "bifurcation.md", markdown(record))

@@ -7,16 +7,18 @@ run's sessions. A log written before logs named their command is taken over by t
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from drake_biped.params import ParameterError
 from drake_biped.records import set_aside, write_atomic
 
-__all__ = ["RUN_LOG", "RunProgress", "SessionLog", "check_run_log", "run_log_command"]
+__all__ = ["RUN_LOG", "RunProgress", "SessionLog", "check_run_log", "progress_bar", "run_log_command"]
 
 RUN_LOG = "run.json"
 
@@ -150,3 +152,26 @@ class RunProgress:
             self.bar.close()
         if self.log.written != self.new:
             self.log.update(self.new, force=True)
+
+
+@contextlib.contextmanager
+def progress_bar(total: int, desc: str, unit: str, enabled: bool = True) -> Iterator[Callable[[int, int], None]]:
+    """tick(done, total): a tqdm bar of a sweep (none when not `enabled`; the total grows when a sweep finds
+    more work), closed on leaving, also on an error."""
+    bar = None
+    if enabled:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, desc=desc, unit=unit)
+
+    def tick(done: int, total: int) -> None:
+        if bar is not None:
+            bar.total = max(bar.total, total)
+            bar.n = done
+            bar.refresh()
+
+    try:
+        yield tick
+    finally:
+        if bar is not None:
+            bar.close()

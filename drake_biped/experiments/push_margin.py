@@ -226,18 +226,12 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
     push_margin.png into `out`. The record."""
     check_settings(settings, PushMarginSettings, "push_margin.run")
     from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import progress_bar
 
     out = Path(out)
     code = versions()
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=settings.episodes, desc="push margin", unit="episode")
-    with client_or_local(client) as c:
-        record = push_margin(settings, c, progress=(lambda n, total: bar.update(1)) if bar else None)
-    if bar is not None:
-        bar.close()
+    with progress_bar(settings.episodes, "push margin", "episode", progress) as tick, client_or_local(client) as c:
+        record = push_margin(settings, c, progress=tick if progress else None)
     record.update(config=settings.config.to_dict(), versions=code)
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "push_margin.json", record)

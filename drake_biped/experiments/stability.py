@@ -331,29 +331,17 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     check_settings(settings, StabilitySettings, "stability.run")
     from drake_biped.analysis.stability_report import write_stability_outputs
     from drake_biped.experiments.executor import client_or_local
+    from drake_biped.experiments.progress import progress_bar
     from drake_biped.records import write_atomic
 
     out = Path(out)
     config = settings.config or EpisodeConfig()
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=6 * settings.trials, desc="stability", unit="episode")
-
-    def report(done: int, total: int) -> None:
-        bar.n = done
-        bar.refresh()
-
-    try:
-        with client_or_local(client) as c:
-            record = run_stability(out, config, settings, c, report if bar is not None else None,
+    with client_or_local(client) as c:
+        with progress_bar(6 * settings.trials, "stability", "episode", progress) as tick:
+            record = run_stability(out, config, settings, c, tick if progress else None,
                                    jacobian_kicks=settings.jacobian_kicks)
-            if settings.floquet:
-                record["floquet"] = _floquet(config, settings.window, out, c)
-    finally:
-        if bar is not None:
-            bar.close()  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
+        if settings.floquet:  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
+            record["floquet"] = _floquet(config, settings.window, out, c)
     write_atomic(out / "stability.json", record)
     write_stability_outputs(record, out)
     return record
