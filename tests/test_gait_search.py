@@ -372,3 +372,24 @@ def test_hold_step_places_windows_by_the_gaits_step_and_subtracts_the_lure(monke
     assert len(seen) == 12
     assert detail["past_step_saving"] == pytest.approx(0.25) and detail["least_saving"] == pytest.approx(0.4)
     assert value == pytest.approx(0.40 - 0.25 + 0.04)  # Table III's CPG: no distance term
+
+
+def test_hold_slow_takes_the_hold_step_score_less_the_penalty_for_a_short_step(monkeypatch):
+    """The same fake walks as above: a 0.42 s step is 0.13 s short of the 0.55 s floor; a 0.6 s step is not."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_robust_score", lambda config, b: (0.0, {"checks": {}}))
+    config = EpisodeConfig().replace(cpg=PAPER_CPG)
+    for period, short in ((0.42, 0.13), (0.6, 0.0)):
+        def long_walk(c, period=period):
+            if c.window.end_s <= c.window.start_s:
+                return {"walked": True, "cost_of_transport": 0.6, "step_period_s": period}
+            return {"walked": True, "cost_of_transport": 0.36, "step_period_s": period}
+
+        monkeypatch.setattr(gait_search, "_long_walk", long_walk)
+        monkeypatch.setattr(gait_search, "_walk", lambda c: {"walked": True, "cost_of_transport": 0.45,
+                                                             "distance_m": 10.0})
+        step, _ = gait_search.OBJECTIVES["hold-step"].score(config, base, (), 0)
+        value, detail = gait_search.OBJECTIVES["hold-slow"].score(config, base, (), 0)
+        assert step == pytest.approx(0.40 - 0.10 + 0.04)
+        assert detail["short_of_floor_s"] == pytest.approx(short)
+        assert value == pytest.approx(step - gait_search.HOLD_SLOW_PENALTY * short)

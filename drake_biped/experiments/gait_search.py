@@ -8,7 +8,7 @@ the shipped gaits were found: "steady" (the first default) from a walker of an e
 
 Score of a configuration that does not walk `distance_m` without a window: -9 + 8 * (the fraction of the
 distance it walked), so that a search from a gait that falls climbs towards one that walks (the "robust",
-"story", "hold", "hold-long" and "hold-step" objectives score fallers themselves). Of one that walks, by the objective:
+"story" and "hold..." objectives score fallers themselves). Of one that walks, by the objective:
 OBJECTIVES, one entry per objective with its scoring function and what it scores (`drake-biped
 gait-search --help` prints them).
 
@@ -131,6 +131,11 @@ HOLD_LONG_M = 40.0
 # window that never acts in the steady gait still acts, and saves, in a 10 m episode).
 HOLD_STEP_BELOW_S = (0.08, 0.04, 0.015)
 HOLD_STEP_PAST_S = (0.015, 0.04)
+# The "hold-slow" objective: "hold-step" on a gait whose powered step lasts at least HOLD_SLOW_FLOOR_S. GARB
+# starts at t1 = 0.5 s; on a shorter step every window near its start is no window in the steady gait, and the
+# only way down is the initiation's lure. Each second short of the floor costs HOLD_SLOW_PENALTY.
+HOLD_SLOW_FLOOR_S = 0.55
+HOLD_SLOW_PENALTY = 4.0
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -398,6 +403,15 @@ def _hold_step_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                    "step_period_s": period, "distance_from_table_iii": d}
 
 
+def _hold_slow_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-slow" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    value, detail = _hold_step_score(config, base)
+    if "step_period_s" not in detail:
+        return value, detail
+    short = max(0.0, HOLD_SLOW_FLOOR_S - detail["step_period_s"])
+    return value - HOLD_SLOW_PENALTY * short, {**detail, "short_of_floor_s": short}
+
+
 Score = Callable[[EpisodeConfig, dict[str, Any], Any, int], tuple[float, dict[str, Any]]]
 
 
@@ -476,6 +490,10 @@ def _hold_step_objective(config, base, windows, draws):
     return _hold_step_score(config, base)
 
 
+def _hold_slow_objective(config, base, windows, draws):
+    return _hold_slow_score(config, base)
+
+
 # Every objective a search can score by: its function and what it scores (the module docstring, the command's
 # help and the search's records read the names and the texts from here).
 OBJECTIVES: dict[str, Objective] = {
@@ -492,6 +510,7 @@ OBJECTIVES: dict[str, Objective] = {
     "hold": Objective(_hold_objective, True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
     "hold-long": Objective(_hold_long_objective, True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
     "hold-step": Objective(_hold_step_objective, True, 'The "robust" objective first, then windows placed by the gait\'s own powered step period T (its long walk without a window): t1 = T - HOLD_STEP_BELOW_S (the hip off until the foot lands) judged as in "hold-long", minus the largest saving of a 10 m episode from the initiation with t1 = T + HOLD_STEP_PAST_S (a window that saves there only while the initiation\'s long first steps last draws GARB past the step\'s end): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
+    "hold-slow": Objective(_hold_slow_objective, True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
 }
 
 
