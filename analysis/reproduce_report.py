@@ -168,6 +168,14 @@ def _steps(n: int) -> str:
     return f"{n} step" if n == 1 else f"{n} steps"
 
 
+def floquet_text(gaits: dict[str, Any]) -> str:
+    """Each gait's spectral radius and what it establishes; no radius where no perturbation size converged
+    (the largest eigenvalue of an unconverged Jacobian measures nothing)."""
+    return ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
+                     if g.get("converged_epsilon") is not None else f"{name}: {record_verdict(g)}"
+                     for name, g in gaits.items())
+
+
 def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]]:
     """The verdict tuples as keyed rows (CLAIM_KEYS)."""
     keys = CLAIM_KEYS
@@ -295,10 +303,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append(("Push margins (forward / backward)", "survives ±20 N", f"none {_n(m['without']['forward'])} / "
                      f"{_n(m['without']['backward'])} N, {wtext} {_n(m['with']['forward'])} / "
                      f"{_n(m['with']['backward'])} N", BEYOND))
-    fl = s["floquet"]["gaits"]
     verdicts.append(("Full-state Floquet multipliers (periodic orbit, through Drake)", "—",
-                     ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
-                               for name, g in fl.items()), BEYOND))
+                     floquet_text(s["floquet"]["gaits"]), BEYOND))
     if "dynamics" in s:
         verdicts += dynamics_rows(s["dynamics"], wtext)
     on_2deg = ("with the grid's best" if climbs_2deg(s["grid_slope2deg"])
@@ -416,7 +422,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "10⁻⁴, where the sweep converges); the sweep's larger ε show the map contracting at the pushes' scale.",
         "",
     ]
-    for name in fl:
+    for name in s["floquet"]["gaits"]:
         lines += [embed(_read(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
                   f"![Floquet multipliers, {name}](floquet/{name}/floquet.png)", ""]
     if "dynamics" in s:
@@ -631,9 +637,7 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
         st = s["learn"]["settings"]
         mine["learn"] = (f"{ours} after {st['trials']} × {st['episodes']} episodes (the paper: 500)", CANNOT_JUDGE)
     if "floquet" in s:
-        fl = s["floquet"]["gaits"]
-        mine["floquet"] = (", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
-                                     for name, g in fl.items()), BEYOND)
+        mine["floquet"] = (floquet_text(s["floquet"]["gaits"]), BEYOND)
     checks = (s.get("full_run") or {}).get("checks", {})
     rows = []
     for row in (full_run or {}).get("rows", []):

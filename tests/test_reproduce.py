@@ -11,6 +11,7 @@ from drake_biped.analysis.reproduce_report import (
     PARTLY,
     REPRODUCED,
     embed,
+    floquet_text,
     reduction_verdict,
     slope_verdict,
     stability_verdict,
@@ -34,6 +35,14 @@ def test_reduction_verdict_follows_the_papers_40_to_50_percent_claim():
     assert reduction_verdict(_evaluation(None))[1] == NOT_REPRODUCED
     ours, _ = reduction_verdict(_evaluation(0.35, ((0.1, 0.4, False), (0.5, 0.3, False), (0.1, 0.8, True))))
     assert "C_mt -35.0 %" in ours and "2 of 3 trials" in ours and "1 end with a window" in ours
+
+
+def test_a_floquet_row_gives_no_radius_where_no_perturbation_converged():
+    converged = {"spectral_radius": 0.449, "converged_epsilon": 1e-7, "fixed_point_residual": 1e-4,
+                 "newton_tolerance": 1e-3, "evaluation_noise": None}
+    unconverged = {**converged, "spectral_radius": 59792.3, "converged_epsilon": None}
+    text = floquet_text({"none": converged, "learned": unconverged})
+    assert text == "none ρ 0.449 (stable), learned: not established: the Jacobian did not converge"
 
 
 def test_slope_verdict_needs_all_three_claims():

@@ -142,7 +142,7 @@ def _rewalked(row: dict[str, Any]) -> str:
 
 def _wall(row: dict[str, Any]) -> str:
     if row.get("replayed_from"):
-        return f"replayed from {row['replayed_from']}"
+        return f"replayed from {Path(row['replayed_from']).name}/"  # the folder's name: the record keeps its path
     return f"{row['wall_s'] / 60:.1f}"
 
 
