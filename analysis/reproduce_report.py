@@ -172,7 +172,8 @@ def floquet_text(gaits: dict[str, Any]) -> str:
     """Each gait's spectral radius and what it establishes; no radius where no perturbation size converged
     (the largest eigenvalue of an unconverged Jacobian measures nothing)."""
     return ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
-                     if g.get("converged_epsilon") is not None else f"{name}: {record_verdict(g)}"
+                     if g.get("converged_epsilon") is not None
+                     else f"{name}: {record_verdict(g)} (Newton's residual {g['fixed_point_residual']:.1e})"
                      for name, g in gaits.items())
 
 
