@@ -110,11 +110,11 @@ class Profile:
 QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 2.0, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
-# The full run: 79 min on 2 workers from scratch, its largest parts the learners' comparison (29 min), GARB's
-# two learning runs (31 min) and the Table IV grid (10 min) (docs/HISTORY.md, its steps counted one by one; the
-# same steps took 2.0-2.5 x as long on another 2-core machine).
+# The full run: about 117 min on 2 workers from scratch (benchmarks/results/reproduce-full/, each step's
+# summary.json), its largest parts the learners' comparison (25 min), GARB's two learning runs (18 and 14 min),
+# the push margins (21 min) and the Table IV grid (9 min).
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 5.0, (2, 100), True,
-               (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 80.0, compare=(5, 300), rewalk_distance_m=110.0)
+               (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 120.0, compare=(5, 300), rewalk_distance_m=110.0)
 
 
 class Reproduction:
