@@ -301,7 +301,8 @@ def run(settings: BifurcationSettings, out: Path, client=None, progress: bool = 
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    with progress_bar(len(settings.values) * len(settings.time_steps), "bifurcation", "walk", progress) as tick, client_or_local(client) as c:
+    walks_count = len(settings.values) * len(settings.time_steps)
+    with progress_bar(walks_count, "bifurcation", "walk", progress) as tick, client_or_local(client) as c:
         record = bifurcation(settings, out, c, tick)
     record.update(config=settings.config.to_dict(), versions=versions())
     write_atomic(out / "bifurcation.json", record)

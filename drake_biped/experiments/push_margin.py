@@ -230,8 +230,9 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
 
     out = Path(out)
     code = versions()
-    with progress_bar(settings.episodes, "push margin", "episode", progress) as tick, client_or_local(client) as c:
-        record = push_margin(settings, c, progress=tick if progress else None)
+    with progress_bar(settings.episodes, "push margin", "episode", progress) as tick, \
+            client_or_local(client) as c:
+        record = push_margin(settings, c, progress=tick)
     record.update(config=settings.config.to_dict(), versions=code)
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "push_margin.json", record)

@@ -338,7 +338,7 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     config = settings.config or EpisodeConfig()
     with client_or_local(client) as c:
         with progress_bar(6 * settings.trials, "stability", "episode", progress) as tick:
-            record = run_stability(out, config, settings, c, tick if progress else None,
+            record = run_stability(out, config, settings, c, tick,
                                    jacobian_kicks=settings.jacobian_kicks)
         if settings.floquet:  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
             record["floquet"] = _floquet(config, settings.window, out, c)
