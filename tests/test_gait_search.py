@@ -393,3 +393,33 @@ def test_hold_slow_takes_the_hold_step_score_less_the_penalty_for_a_short_step(m
         assert step == pytest.approx(0.40 - 0.10 + 0.04)
         assert detail["short_of_floor_s"] == pytest.approx(short)
         assert value == pytest.approx(step - gait_search.HOLD_SLOW_PENALTY * short)
+
+
+def test_hold_edge_scores_the_least_long_run_saving_at_the_band_top_less_the_start_lure(monkeypatch):
+    """Fake walks: every fixed window saves 40 % long-run except t1 0.44 s at half the plant step (5 %, the edge
+    moved by the step), and 10 m episodes at t1 0.48 / 0.50 s save 20 % / 30 %: score = 0.05 - 0.30 + 0.1 x mean."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_robust_score", lambda config, b: (0.0, {"checks": {}}))
+    seen = []
+
+    def long_walk(config):
+        if config.window.end_s <= config.window.start_s:
+            return {"walked": True, "cost_of_transport": 0.6, "step_period_s": 0.46}
+        half = config.sim.time_step_s < EpisodeConfig().sim.time_step_s
+        seen.append((round(config.window.start_s, 3), half))
+        saving = 0.05 if half and round(config.window.start_s, 3) == 0.44 else 0.40
+        return {"walked": True, "cost_of_transport": 0.6 * (1 - saving), "step_period_s": 0.5}
+
+    def walk(config):
+        saving = {0.48: 0.20, 0.5: 0.30}[round(config.window.start_s, 3)]
+        return {"walked": True, "cost_of_transport": 0.5 * (1 - saving), "distance_m": 10.0}
+
+    monkeypatch.setattr(gait_search, "_long_walk", long_walk)
+    monkeypatch.setattr(gait_search, "_walk", walk)
+    config = EpisodeConfig().replace(cpg=PAPER_CPG)
+    value, detail = gait_search.OBJECTIVES["hold-edge"].score(config, base, (), 0)
+    assert sorted({t1 for t1, _ in seen}) == [0.40, 0.42, 0.44] and len(seen) == 12
+    assert sum(half for _, half in seen) == 3  # each window once at half the step
+    assert detail["least_saving"] == pytest.approx(0.05) and detail["lure_saving"] == pytest.approx(0.30)
+    mean = (11 * 0.40 + 0.05) / 12
+    assert value == pytest.approx(0.05 - 0.30 + 0.1 * mean)  # Table III's CPG: no distance term

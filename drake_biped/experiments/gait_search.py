@@ -136,6 +136,14 @@ HOLD_STEP_PAST_S = (0.015, 0.04)
 # only way down is the initiation's lure. Each second short of the floor costs HOLD_SLOW_PENALTY.
 HOLD_SLOW_FLOOR_S = 0.55
 HOLD_SLOW_PENALTY = 4.0
+# The "hold-edge" objective: windows across the top of the band where GARB's means ended on the default and
+# u_r 8.0 gaits (t1 0.37-0.44 s), judged long-run like "hold-long". The coasting gait such windows lock into is
+# the only attractor up to an edge in t1 that moves with the plant step (on the u_r 8.0 gait t1 0.42 s saves 46 %
+# at 1 and at 0.5 ms, t1 0.44 s 35 % at 1 ms and 4 % at 0.5 ms), so the half step is the check that decides.
+# Less the larger 10 m saving at HOLD_EDGE_LURE (the learner's start region: a saving there holds GARB's means
+# where the steady gait's windows do not act).
+HOLD_EDGE_WINDOWS = ((0.40, 1.2), (0.42, 1.2), (0.44, 1.2))
+HOLD_EDGE_LURE = ((0.48, 1.2), (0.50, 1.2))
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -412,6 +420,21 @@ def _hold_slow_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     return value - HOLD_SLOW_PENALTY * short, {**detail, "short_of_floor_s": short}
 
 
+def _hold_edge_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-edge" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    early, detail = _long_windows(config, base, lambda bases: HOLD_EDGE_WINDOWS)
+    if early is not None:
+        return early, detail
+    savings = detail.pop("savings")
+    lured = [{"window": list(w), **_walk(config.replace(window=TorqueFreeWindow(*w)))} for w in HOLD_EDGE_LURE]
+    lure = max([0.0, *(_saving(row, base) for row in lured if row["walked"])])
+    least = min(savings)
+    d = distance_from_table_iii(config.cpg)
+    value = least - lure + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
+    return value, {**detail, "lure_windows": lured, "least_saving": least, "lure_saving": lure,
+                   "step_period_s": detail["long_bases"]["as_is"]["step_period_s"], "distance_from_table_iii": d}
+
+
 Score = Callable[[EpisodeConfig, dict[str, Any], Any, int], tuple[float, dict[str, Any]]]
 
 
@@ -494,6 +517,10 @@ def _hold_slow_objective(config, base, windows, draws):
     return _hold_slow_score(config, base)
 
 
+def _hold_edge_objective(config, base, windows, draws):
+    return _hold_edge_score(config, base)
+
+
 # Every objective a search can score by: its function and what it scores (the module docstring, the command's
 # help and the search's records read the names and the texts from here).
 OBJECTIVES: dict[str, Objective] = {
@@ -511,6 +538,7 @@ OBJECTIVES: dict[str, Objective] = {
     "hold-long": Objective(_hold_long_objective, True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
     "hold-step": Objective(_hold_step_objective, True, 'The "robust" objective first, then windows placed by the gait\'s own powered step period T (its long walk without a window): t1 = T - HOLD_STEP_BELOW_S (the hip off until the foot lands) judged as in "hold-long", minus the largest saving of a 10 m episode from the initiation with t1 = T + HOLD_STEP_PAST_S (a window that saves there only while the initiation\'s long first steps last draws GARB past the step\'s end): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-slow": Objective(_hold_slow_objective, True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
+    "hold-edge": Objective(_hold_edge_objective, True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
 }
 
 
