@@ -423,3 +423,19 @@ def test_hold_edge_scores_the_least_long_run_saving_at_the_band_top_less_the_sta
     assert detail["least_saving"] == pytest.approx(0.05) and detail["lure_saving"] == pytest.approx(0.30)
     mean = (11 * 0.40 + 0.05) / 12
     assert value == pytest.approx(0.05 - 0.30 + 0.1 * mean)  # Table III's CPG: no distance term
+
+
+def test_hold_pull_adds_the_start_policys_mean_gain_to_hold_edge(monkeypatch):
+    """Fake walks: hold-edge scores 0.2; of four start draws one falls (gain -1), one saves 50 % (reward x 2), two
+    are no window (gain 0): score = 0.2 + (-1 + 1 + 0 + 0) / 4."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_hold_edge_score",
+                        lambda config, b: (0.2, {"lure_saving": 0.1, "least_saving": 0.35}))
+    rows = [{"reward": 0.0}, {"reward": 4.0}, {"reward": 2.0}, {"reward": 2.0}]
+    monkeypatch.setattr(gait_search, "_window_rows", lambda config, windows, b: rows[:len(windows)])
+    value, detail = gait_search.OBJECTIVES["hold-pull"].score(EpisodeConfig(), base, (), 4)
+    assert detail["start_gain"] == pytest.approx(0.0)
+    assert value == pytest.approx(0.2)
+    rows[0] = {"reward": 2.0}  # the faller walks as no window would: the start's mean gain is 1 / 4
+    value, detail = gait_search.OBJECTIVES["hold-pull"].score(EpisodeConfig(), base, (), 4)
+    assert value == pytest.approx(0.2 + 0.25) and detail["least_saving"] == pytest.approx(0.35)
