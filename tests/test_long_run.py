@@ -113,3 +113,24 @@ def test_the_default_gait_converges_over_long_walks_and_a_long_control_period_st
     assert max(costs) / min(costs) - 1.0 < 0.01
     coarse = run_episode(EpisodeConfig().override({"sim.time_step_s": 1e-2, "sim.control_period_s": 1e-2}))
     assert coarse.termination == "diverged"
+
+
+def test_walk_prints_the_long_run_cost_only_for_a_walk_long_enough_for_it():
+    """`drake-biped walk` adds the long-run line for a walk of at least 110 m that did not fall, from the walk's
+    own long_run(); a shorter walk or a fall gets none."""
+    from types import SimpleNamespace
+
+    from drake_biped.experiments.walk import long_run_lines
+
+    lr = {"cost_of_transport": 0.3047, "half_width": 0.0051, "distance_m": 100.2, "steps": 220,
+          "step_period_mean_s": 0.5243, "step_period_std_s": 0.0375}
+
+    def walk(distance, fell=False):
+        return SimpleNamespace(fell=fell, distance_m=distance, long_run=lambda: lr)
+
+    (line,) = long_run_lines(walk(110.0))
+    assert "long-run C_mt 0.3047 ± 0.0051" in line and "100.2 m after the first 10 m" in line
+    assert "220 steps of 0.524 ± 0.037 s" in line
+    assert long_run_lines(walk(109.9)) == [] and long_run_lines(walk(110.0, fell=True)) == []
+    lr["cost_of_transport"] = None  # too few steps for batch means
+    assert long_run_lines(walk(110.0)) == []

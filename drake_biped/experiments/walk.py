@@ -167,8 +167,25 @@ def summary_lines(result) -> list[str]:
         f"{len(result.steps)} steps, {gait}",
         f"positive work {result.total_positive_work_j:.1f} J, C_mt {cmt} (E+/(m g d)), "
         f"{cmt_kg} J/(kg m) (paper's eq. 1)",
+        *long_run_lines(result),
         f"wall {result.wall_time_s:.1f} s, real-time factor {result.real_time_factor:.2f}",
     ]
+
+
+def long_run_lines(result) -> list[str]:
+    """The long-run line of a walk that went at least TRANSIENT_M + LONG_RUN_M (110 m) without falling: its C_mt
+    after the initiation's transient, with the 95 % interval, and the kept steps' period; none for a shorter walk
+    (its C_mt is mostly the initiation's)."""
+    from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
+
+    if result.fell or result.distance_m < TRANSIENT_M + LONG_RUN_M - 1e-6:
+        return []
+    lr = result.long_run()
+    if lr["cost_of_transport"] is None:
+        return []
+    return [f"long-run C_mt {lr['cost_of_transport']:.4f} ± {lr['half_width']:.4f} (95 %) over the "
+            f"{lr['distance_m']:.1f} m after the first {TRANSIENT_M:g} m ({lr['steps']} steps of "
+            f"{lr['step_period_mean_s']:.3f} ± {lr['step_period_std_s']:.3f} s)"]
 
 
 def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_trajectory: bool = False,
