@@ -145,9 +145,9 @@ HOLD_SLOW_PENALTY = 4.0
 HOLD_EDGE_WINDOWS = ((0.40, 1.2), (0.42, 1.2), (0.44, 1.2))
 HOLD_EDGE_LURE = ((0.48, 1.2), (0.50, 1.2))
 # The "hold-pull" objective: "hold-edge" plus the mean reward gain of fixed draws of the paper's start policy
-# (the "expected" objective). On the first gait "hold-edge" found, every window up to t1 0.44 s held at half the
-# step, yet two of five GARB trials climbed away from the band: windows from t1 0.2 s with t2 past 0.5 s fall
-# there, and the start policy's draws reach them.
+# (the "expected" objective): what the learner's first episodes meet. On the first gait "hold-edge" found, every
+# window up to t1 0.44 s held at half the step, yet two of five GARB trials left for t2 < t1 (no window), where
+# equal rewards give no gradient back (docs/RESULTS.md).
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
