@@ -439,3 +439,32 @@ def test_hold_pull_adds_the_start_policys_mean_gain_to_hold_edge(monkeypatch):
     rows[0] = {"reward": 2.0}  # the faller walks as no window would: the start's mean gain is 1 / 4
     value, detail = gait_search.OBJECTIVES["hold-pull"].score(EpisodeConfig(), base, (), 4)
     assert value == pytest.approx(0.2 + 0.25) and detail["least_saving"] == pytest.approx(0.35)
+
+
+def test_hold_lure_rewards_the_10m_saving_past_the_band_and_holds_the_band_to_046(monkeypatch):
+    """Fake walks: windows t1 0.40-0.46 s save 40 % long-run under every change except t1 0.46 s at half the plant
+    step (30 %); 10 m episodes at t1 0.48 / 0.50 s save 20 % / 30 %: score = 0.30 + 0.5 x 0.30 + 0.1 x mean."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_robust_score", lambda config, b: (0.0, {"checks": {}}))
+    seen = []
+
+    def long_walk(config):
+        if config.window.end_s <= config.window.start_s:
+            return {"walked": True, "cost_of_transport": 0.6, "step_period_s": 0.46}
+        half = config.sim.time_step_s < EpisodeConfig().sim.time_step_s
+        seen.append(round(config.window.start_s, 3))
+        saving = 0.30 if half and round(config.window.start_s, 3) == 0.46 else 0.40
+        return {"walked": True, "cost_of_transport": 0.6 * (1 - saving), "step_period_s": 0.5}
+
+    def walk(config):
+        saving = {0.48: 0.20, 0.5: 0.30}[round(config.window.start_s, 3)]
+        return {"walked": True, "cost_of_transport": 0.5 * (1 - saving), "distance_m": 10.0}
+
+    monkeypatch.setattr(gait_search, "_long_walk", long_walk)
+    monkeypatch.setattr(gait_search, "_walk", walk)
+    config = EpisodeConfig().replace(cpg=PAPER_CPG)
+    value, detail = gait_search.OBJECTIVES["hold-lure"].score(config, base, (), 0)
+    assert sorted(set(seen)) == [0.40, 0.42, 0.44, 0.46] and len(seen) == 16
+    assert detail["least_saving"] == pytest.approx(0.30) and detail["lure_saving"] == pytest.approx(0.30)
+    mean = (15 * 0.40 + 0.30) / 16
+    assert value == pytest.approx(0.30 + gait_search.HOLD_LURE_WEIGHT * 0.30 + 0.1 * mean)

@@ -148,6 +148,12 @@ HOLD_EDGE_LURE = ((0.48, 1.2), (0.50, 1.2))
 # (the "expected" objective): what the learner's first episodes meet. On the first gait "hold-edge" found, every
 # window up to t1 0.44 s held at half the step, yet two of five GARB trials left for t2 < t1 (no window), where
 # equal rewards give no gradient back (docs/RESULTS.md).
+# The "hold-lure" objective: the band held one window further (HOLD_LURE_WINDOWS, to t1 0.46 s) and the 10 m
+# saving at HOLD_EDGE_LURE rewarded (HOLD_LURE_WEIGHT) rather than subtracted. GARB's means come back from the
+# no-window half of its start only through a window near it that saves over 10 m, and then stop just inside the
+# edge of that saving (docs/RESULTS.md): the band must hold, at half the step too, up to where they stop.
+HOLD_LURE_WINDOWS = ((0.40, 1.2), (0.42, 1.2), (0.44, 1.2), (0.46, 1.2))
+HOLD_LURE_WEIGHT = 0.5
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -424,9 +430,12 @@ def _hold_slow_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     return value - HOLD_SLOW_PENALTY * short, {**detail, "short_of_floor_s": short}
 
 
-def _hold_edge_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
-    """The "hold-edge" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
-    early, detail = _long_windows(config, base, lambda bases: HOLD_EDGE_WINDOWS)
+def _band_and_lure(config: EpisodeConfig, base: dict[str, Any], windows, lure_weight: float
+                   ) -> tuple[float, dict[str, Any]]:
+    """What "hold-edge" and "hold-lure" share: `windows` judged as in "hold-long", and the larger 10 m saving at
+    HOLD_EDGE_LURE counted with `lure_weight`: least saving + lure_weight x lure + 0.1 x the mean saving - 0.01 d /
+    (1 + d), with what it measured; `base` may be a fall."""
+    early, detail = _long_windows(config, base, lambda bases: windows)
     if early is not None:
         return early, detail
     savings = detail.pop("savings")
@@ -434,9 +443,19 @@ def _hold_edge_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     lure = max([0.0, *(_saving(row, base) for row in lured if row["walked"])])
     least = min(savings)
     d = distance_from_table_iii(config.cpg)
-    value = least - lure + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
+    value = least + lure_weight * lure + 0.1 * sum(savings) / len(savings) - 0.01 * d / (1.0 + d)
     return value, {**detail, "lure_windows": lured, "least_saving": least, "lure_saving": lure,
                    "step_period_s": detail["long_bases"]["as_is"]["step_period_s"], "distance_from_table_iii": d}
+
+
+def _hold_edge_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-edge" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    return _band_and_lure(config, base, HOLD_EDGE_WINDOWS, -1.0)
+
+
+def _hold_lure_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-lure" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    return _band_and_lure(config, base, HOLD_LURE_WINDOWS, HOLD_LURE_WEIGHT)
 
 
 def _hold_pull_score(config: EpisodeConfig, base: dict[str, Any], draws: int) -> tuple[float, dict[str, Any]]:
@@ -534,6 +553,10 @@ def _hold_edge_objective(config, base, windows, draws):
     return _hold_edge_score(config, base)
 
 
+def _hold_lure_objective(config, base, windows, draws):
+    return _hold_lure_score(config, base)
+
+
 def _hold_pull_objective(config, base, windows, draws):
     return _hold_pull_score(config, base, draws)
 
@@ -556,6 +579,7 @@ OBJECTIVES: dict[str, Objective] = {
     "hold-step": Objective(_hold_step_objective, True, 'The "robust" objective first, then windows placed by the gait\'s own powered step period T (its long walk without a window): t1 = T - HOLD_STEP_BELOW_S (the hip off until the foot lands) judged as in "hold-long", minus the largest saving of a 10 m episode from the initiation with t1 = T + HOLD_STEP_PAST_S (a window that saves there only while the initiation\'s long first steps last draws GARB past the step\'s end): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-slow": Objective(_hold_slow_objective, True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
     "hold-edge": Objective(_hold_edge_objective, True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
+    "hold-lure": Objective(_hold_lure_objective, True, 'The "robust" objective first, then HOLD_LURE_WINDOWS (t1 0.40 to 0.46 s, the hip off until the foot lands) judged as in "hold-long", plus HOLD_LURE_WEIGHT x the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s: what brings GARB\'s means back from the no-window half of its start): least saving + 0.5 x that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-pull": Objective(_hold_pull_objective, True, 'The "hold-edge" score plus the mean reward gain over --policy-draws fixed draws of the paper\'s start policy ((0.5, 0.5), variance 0.04; the "expected" objective): where the learner\'s first episodes fall or save.'),
 }
 
