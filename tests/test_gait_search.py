@@ -395,10 +395,10 @@ def test_hold_slow_takes_the_hold_step_score_less_the_penalty_for_a_short_step(m
         assert value == pytest.approx(step - gait_search.HOLD_SLOW_PENALTY * short)
 
 
-def test_hold_edge_scores_the_least_long_run_saving_at_the_band_top_less_the_start_lure(monkeypatch):
-    """Fake walks: every fixed window saves 40 % long-run except t1 0.44 s at half the plant step (5 %, the edge
-    moved by the step), and 10 m episodes at t1 0.48 / 0.50 s save 20 % / 30 %: score = 0.05 - 0.30 + 0.1 x mean."""
-    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+def _fake_band_walks(monkeypatch, weak_t1: float, weak_saving: float) -> list[tuple[float, bool]]:
+    """Fake walks for "hold-edge" and "hold-lure": every band window saves 40 % long-run under every change except
+    t1 `weak_t1` at half the plant step (`weak_saving`); 10 m episodes at t1 0.48 / 0.50 s save 20 % / 30 %. The
+    (t1, at half the step) of each long walk with a window, as walked."""
     monkeypatch.setattr(gait_search, "_robust_score", lambda config, b: (0.0, {"checks": {}}))
     seen = []
 
@@ -407,7 +407,7 @@ def test_hold_edge_scores_the_least_long_run_saving_at_the_band_top_less_the_sta
             return {"walked": True, "cost_of_transport": 0.6, "step_period_s": 0.46}
         half = config.sim.time_step_s < EpisodeConfig().sim.time_step_s
         seen.append((round(config.window.start_s, 3), half))
-        saving = 0.05 if half and round(config.window.start_s, 3) == 0.44 else 0.40
+        saving = weak_saving if half and round(config.window.start_s, 3) == weak_t1 else 0.40
         return {"walked": True, "cost_of_transport": 0.6 * (1 - saving), "step_period_s": 0.5}
 
     def walk(config):
@@ -416,6 +416,14 @@ def test_hold_edge_scores_the_least_long_run_saving_at_the_band_top_less_the_sta
 
     monkeypatch.setattr(gait_search, "_long_walk", long_walk)
     monkeypatch.setattr(gait_search, "_walk", walk)
+    return seen
+
+
+def test_hold_edge_scores_the_least_long_run_saving_at_the_band_top_less_the_start_lure(monkeypatch):
+    """Fake walks: every fixed window saves 40 % long-run except t1 0.44 s at half the plant step (5 %, the edge
+    moved by the step), and 10 m episodes at t1 0.48 / 0.50 s save 20 % / 30 %: score = 0.05 - 0.30 + 0.1 x mean."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    seen = _fake_band_walks(monkeypatch, 0.44, 0.05)
     config = EpisodeConfig().replace(cpg=PAPER_CPG)
     value, detail = gait_search.OBJECTIVES["hold-edge"].score(config, base, (), 0)
     assert sorted({t1 for t1, _ in seen}) == [0.40, 0.42, 0.44] and len(seen) == 12
@@ -445,26 +453,10 @@ def test_hold_lure_rewards_the_10m_saving_past_the_band_and_holds_the_band_to_04
     """Fake walks: windows t1 0.40-0.46 s save 40 % long-run under every change except t1 0.46 s at half the plant
     step (30 %); 10 m episodes at t1 0.48 / 0.50 s save 20 % / 30 %: score = 0.30 + 0.5 x 0.30 + 0.1 x mean."""
     base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
-    monkeypatch.setattr(gait_search, "_robust_score", lambda config, b: (0.0, {"checks": {}}))
-    seen = []
-
-    def long_walk(config):
-        if config.window.end_s <= config.window.start_s:
-            return {"walked": True, "cost_of_transport": 0.6, "step_period_s": 0.46}
-        half = config.sim.time_step_s < EpisodeConfig().sim.time_step_s
-        seen.append(round(config.window.start_s, 3))
-        saving = 0.30 if half and round(config.window.start_s, 3) == 0.46 else 0.40
-        return {"walked": True, "cost_of_transport": 0.6 * (1 - saving), "step_period_s": 0.5}
-
-    def walk(config):
-        saving = {0.48: 0.20, 0.5: 0.30}[round(config.window.start_s, 3)]
-        return {"walked": True, "cost_of_transport": 0.5 * (1 - saving), "distance_m": 10.0}
-
-    monkeypatch.setattr(gait_search, "_long_walk", long_walk)
-    monkeypatch.setattr(gait_search, "_walk", walk)
+    seen = _fake_band_walks(monkeypatch, 0.46, 0.30)
     config = EpisodeConfig().replace(cpg=PAPER_CPG)
     value, detail = gait_search.OBJECTIVES["hold-lure"].score(config, base, (), 0)
-    assert sorted(set(seen)) == [0.40, 0.42, 0.44, 0.46] and len(seen) == 16
+    assert sorted({t1 for t1, _ in seen}) == [0.40, 0.42, 0.44, 0.46] and len(seen) == 16
     assert detail["least_saving"] == pytest.approx(0.30) and detail["lure_saving"] == pytest.approx(0.30)
     mean = (15 * 0.40 + 0.30) / 16
     assert value == pytest.approx(0.30 + gait_search.HOLD_LURE_WEIGHT * 0.30 + 0.1 * mean)
