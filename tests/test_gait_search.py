@@ -460,3 +460,33 @@ def test_hold_lure_rewards_the_10m_saving_past_the_band_and_holds_the_band_to_04
     assert detail["least_saving"] == pytest.approx(0.30) and detail["lure_saving"] == pytest.approx(0.30)
     mean = (15 * 0.40 + 0.30) / 16
     assert value == pytest.approx(0.30 + gait_search.HOLD_LURE_WEIGHT * 0.30 + 0.1 * mean)
+
+
+def test_hold_sure_takes_off_early_window_falls_and_steady_push_falls(monkeypatch):
+    """Fake walks: "hold-lure" scores 0.5; of the early windows only (0, 0.6) falls; steps last 0.5 s, and without
+    a window the forward push falls at the last two of six phases of the first step after 5 s, every other push
+    walks: score = 0.5 - 1 x 1/6 - 2 x 2/24."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_hold_lure_score", lambda config, b: (0.5, {"lure_saving": 0.3}))
+    monkeypatch.setattr(gait_search, "_touchdowns", lambda config: (True, [0.5 * k for k in range(1, 30)]))
+    pushed = []
+
+    def walk(config):
+        window = (config.window.start_s, config.window.end_s)
+        if config.push is None:
+            return {"walked": window != (0.0, 0.6), "cost_of_transport": 0.3, "distance_m": 10.0}
+        assert config.sim.distance_m == gait_search.SURE_PUSH_M
+        phase = round((config.push.start_s - 5.0) / 0.5 * gait_search.SURE_PUSH_PHASES)
+        pushed.append((window, config.push.force_n, phase))
+        falls = window == (0.0, 0.0) and config.push.force_n > 0 and phase >= 4
+        return {"walked": not falls, "cost_of_transport": 0.3, "distance_m": 12.0}
+
+    monkeypatch.setattr(gait_search, "_walk", walk)
+    value, detail = gait_search.OBJECTIVES["hold-sure"].score(EpisodeConfig(), base, (), 0)
+    assert len(pushed) == 24 and {p for _, _, p in pushed} == set(range(6))
+    assert {f for _, f, _ in pushed} == {gait_search.PUSH_FORCE_N, -gait_search.PUSH_FORCE_N}
+    assert detail["early_falls"] == pytest.approx(1 / 6) and detail["push_falls"] == pytest.approx(2 / 24)
+    assert value == pytest.approx(0.5 - gait_search.SURE_FALL_PENALTY / 6 - gait_search.SURE_PUSH_PENALTY * 2 / 24)
+    monkeypatch.setattr(gait_search, "_touchdowns", lambda config: (False, [0.5, 1.0]))  # falls unpushed
+    value, detail = gait_search.OBJECTIVES["hold-sure"].score(EpisodeConfig(), base, (), 0)
+    assert detail["push_falls"] == 1.0 and value == pytest.approx(0.5 - 1 / 6 - gait_search.SURE_PUSH_PENALTY)

@@ -154,6 +154,16 @@ HOLD_EDGE_LURE = ((0.48, 1.2), (0.50, 1.2))
 # edge of that saving (docs/RESULTS.md): the band must hold, at half the step too, up to where they stop.
 HOLD_LURE_WINDOWS = ((0.40, 1.2), (0.42, 1.2), (0.44, 1.2), (0.46, 1.2))
 HOLD_LURE_WEIGHT = 0.5
+# The "hold-sure" objective: "hold-lure" less what its gait still failed on (docs/RESULTS.md). GARB's first
+# episodes (step size 0.1) can carry a mean down the diagonal towards t1 0, where windows that fall over 10 m
+# (SURE_EARLY_WINDOWS) drive it on into t2 < t1 with a fall's low reward; and the paper's +-PUSH_FORCE_N, pushed
+# in steady state as `push-margin` pushes (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a
+# SURE_PUSH_M walk), without a window and with SURE_PUSH_WINDOW from the band. Each costs its penalty times the
+# fraction that falls.
+SURE_EARLY_WINDOWS = ((0.0, 0.3), (0.0, 0.45), (0.0, 0.6), (0.1, 0.5), (0.2, 0.6), (0.3, 0.7))
+SURE_PUSH_PHASES, SURE_SETTLE_S, SURE_PUSH_M = 6, 5.0, 12.0
+SURE_PUSH_WINDOW = (0.42, 1.2)
+SURE_FALL_PENALTY, SURE_PUSH_PENALTY = 1.0, 2.0
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -458,6 +468,55 @@ def _hold_lure_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     return _band_and_lure(config, base, HOLD_LURE_WINDOWS, HOLD_LURE_WEIGHT)
 
 
+def _touchdowns(config: EpisodeConfig) -> tuple[bool, list[float]]:
+    """Whether `config` walks its distance, and its touchdown times (s)."""
+    from drake_biped.episode import run_episode
+
+    r = run_episode(config)
+    return (not r.fell) and r.distance_m >= config.sim.distance_m - 1e-6, [s.touchdown_time_s for s in r.steps]
+
+
+def _steady_push_rows(config: EpisodeConfig, window: tuple[float, float]) -> list[dict[str, Any]]:
+    """`_walk` of a SURE_PUSH_M walk of `config` with `window` ((0, 0): none) under a forward and a backward push
+    of PUSH_FORCE_N at each of SURE_PUSH_PHASES phases of its first step from SURE_SETTLE_S on (`push-margin`'s
+    pushes), each row tagged with its force and start; every push counts as a fall when the walk does not walk
+    unpushed or has no step after SURE_SETTLE_S."""
+    from drake_biped.experiments.push_margin import steady_step
+    from drake_biped.paper import PUSH_DURATION_S
+    from drake_biped.params import Push
+
+    walk = config.override({"sim.distance_m": SURE_PUSH_M, "sim.max_time_s": max(config.sim.max_time_s,
+                                                                                  6.0 * SURE_PUSH_M)})
+    walk = walk.replace(window=TorqueFreeWindow(*window), push=None)
+    walked, times = _touchdowns(walk)
+    step = steady_step({"steps": [{"touchdown_time_s": t} for t in times]}, SURE_SETTLE_S) if walked else None
+    rows = []
+    for sign in (1.0, -1.0):
+        for j in range(SURE_PUSH_PHASES):
+            if step is None:
+                rows.append({"walked": False, "push_n": sign * PUSH_FORCE_N, "start_s": None})
+                continue
+            start = step[0] + (j / SURE_PUSH_PHASES) * (step[1] - step[0])
+            row = _walk(walk.replace(push=Push(sign * PUSH_FORCE_N, start, PUSH_DURATION_S)))
+            rows.append({**row, "push_n": sign * PUSH_FORCE_N, "start_s": start})
+    return rows
+
+
+def _hold_sure_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "hold-sure" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
+    value, detail = _hold_lure_score(config, base)
+    if "lure_saving" not in detail:
+        return value, detail
+    early = [{"window": list(w), **_walk(config.replace(window=TorqueFreeWindow(*w)))} for w in SURE_EARLY_WINDOWS]
+    pushes = {"without": _steady_push_rows(config, (0.0, 0.0)), "with": _steady_push_rows(config, SURE_PUSH_WINDOW)}
+    early_falls = sum(not row["walked"] for row in early) / len(early)
+    rows = [row for condition in pushes.values() for row in condition]
+    push_falls = sum(not row["walked"] for row in rows) / len(rows)
+    value -= SURE_FALL_PENALTY * early_falls + SURE_PUSH_PENALTY * push_falls
+    return value, {**detail, "early_windows": early, "steady_pushes": pushes, "early_falls": early_falls,
+                   "push_falls": push_falls}
+
+
 def _hold_pull_score(config: EpisodeConfig, base: dict[str, Any], draws: int) -> tuple[float, dict[str, Any]]:
     """The "hold-pull" objective (OBJECTIVES) and what it measured; `base` may be a fall."""
     value, detail = _hold_edge_score(config, base)
@@ -557,6 +616,10 @@ def _hold_lure_objective(config, base, windows, draws):
     return _hold_lure_score(config, base)
 
 
+def _hold_sure_objective(config, base, windows, draws):
+    return _hold_sure_score(config, base)
+
+
 def _hold_pull_objective(config, base, windows, draws):
     return _hold_pull_score(config, base, draws)
 
@@ -580,6 +643,7 @@ OBJECTIVES: dict[str, Objective] = {
     "hold-slow": Objective(_hold_slow_objective, True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
     "hold-edge": Objective(_hold_edge_objective, True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-lure": Objective(_hold_lure_objective, True, 'The "robust" objective first, then HOLD_LURE_WINDOWS (t1 0.40 to 0.46 s, the hip off until the foot lands) judged as in "hold-long", plus HOLD_LURE_WEIGHT x the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s: what brings GARB\'s means back from the no-window half of its start): least saving + 0.5 x that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
+    "hold-sure": Objective(_hold_sure_objective, True, 'The "hold-lure" score less SURE_FALL_PENALTY x the fraction of SURE_EARLY_WINDOWS (early windows, where GARB\'s first large steps can carry a mean) that fall over the 10 m episode, and less SURE_PUSH_PENALTY x the fraction of the +-PUSH_FORCE_N pushes in steady state (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a SURE_PUSH_M walk, as `push-margin` pushes; without a window and with SURE_PUSH_WINDOW) that fall.'),
     "hold-pull": Objective(_hold_pull_objective, True, 'The "hold-edge" score plus the mean reward gain over --policy-draws fixed draws of the paper\'s start policy ((0.5, 0.5), variance 0.04; the "expected" objective): where the learner\'s first episodes fall or save.'),
 }
 
