@@ -462,12 +462,22 @@ def test_hold_lure_rewards_the_10m_saving_past_the_band_and_holds_the_band_to_04
     assert value == pytest.approx(0.30 + gait_search.HOLD_LURE_WEIGHT * 0.30 + 0.1 * mean)
 
 
-def test_hold_sure_takes_off_early_window_falls_and_steady_push_falls(monkeypatch):
+def test_hold_sure_takes_off_early_window_falls_steady_push_falls_and_the_quarter_steps_drift(monkeypatch):
     """Fake walks: "hold-lure" scores 0.5; of the early windows only (0, 0.6) falls; steps last 0.5 s, and without
     a window the forward push falls at the last two of six phases of the first step after 5 s, every other push
-    walks: score = 0.5 - 1 x 1/6 - 2 x 2/24."""
+    walks; at a quarter of the plant step the walk without a window costs 3 % more: score = 0.5 - 1 x 1/6 -
+    2 x 2/24 - 10 x (0.03 - 0.01)."""
     base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
-    monkeypatch.setattr(gait_search, "_hold_lure_score", lambda config, b: (0.5, {"lure_saving": 0.3}))
+    long_bases = {"as_is": {"walked": True, "cost_of_transport": 0.4}}
+    monkeypatch.setattr(gait_search, "_hold_lure_score",
+                        lambda config, b: (0.5, {"lure_saving": 0.3, "long_bases": long_bases}))
+    quarters = []
+
+    def long_walk(config):
+        quarters.append((config.sim.time_step_s, config.window.end_s))
+        return {"walked": True, "cost_of_transport": 0.4 * 1.03}
+
+    monkeypatch.setattr(gait_search, "_long_walk", long_walk)
     monkeypatch.setattr(gait_search, "_touchdowns", lambda config: (True, [0.5 * k for k in range(1, 30)]))
     pushed = []
 
@@ -486,7 +496,11 @@ def test_hold_sure_takes_off_early_window_falls_and_steady_push_falls(monkeypatc
     assert len(pushed) == 24 and {p for _, _, p in pushed} == set(range(6))
     assert {f for _, f, _ in pushed} == {gait_search.PUSH_FORCE_N, -gait_search.PUSH_FORCE_N}
     assert detail["early_falls"] == pytest.approx(1 / 6) and detail["push_falls"] == pytest.approx(2 / 24)
-    assert value == pytest.approx(0.5 - gait_search.SURE_FALL_PENALTY / 6 - gait_search.SURE_PUSH_PENALTY * 2 / 24)
+    assert quarters == [(0.25 * EpisodeConfig().sim.time_step_s, 0.0)]  # no window, a quarter of the step
+    assert detail["quarter_step_change"] == pytest.approx(0.03)
+    drift = gait_search.SURE_STEP_PENALTY * (0.03 - gait_search.SURE_STEP_TOLERANCE)
+    assert value == pytest.approx(0.5 - gait_search.SURE_FALL_PENALTY / 6 - gait_search.SURE_PUSH_PENALTY * 2 / 24
+                                  - drift)
     monkeypatch.setattr(gait_search, "_touchdowns", lambda config: (False, [0.5, 1.0]))  # falls unpushed
     value, detail = gait_search.OBJECTIVES["hold-sure"].score(EpisodeConfig(), base, (), 0)
-    assert detail["push_falls"] == 1.0 and value == pytest.approx(0.5 - 1 / 6 - gait_search.SURE_PUSH_PENALTY)
+    assert detail["push_falls"] == 1.0 and value == pytest.approx(0.5 - 1 / 6 - gait_search.SURE_PUSH_PENALTY - drift)

@@ -159,11 +159,14 @@ HOLD_LURE_WEIGHT = 0.5
 # (SURE_EARLY_WINDOWS) drive it on into t2 < t1 with a fall's low reward; and the paper's +-PUSH_FORCE_N, pushed
 # in steady state as `push-margin` pushes (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a
 # SURE_PUSH_M walk), without a window and with SURE_PUSH_WINDOW from the band. Each costs its penalty times the
-# fraction that falls.
+# fraction that falls. And the walk without a window at a quarter of the plant step, whose long-run C_mt must stay
+# within SURE_STEP_TOLERANCE of the step's (the hold-lure gait's moved by 1.4 % over 110 m): SURE_STEP_PENALTY x
+# the excess (1 for a fall).
 SURE_EARLY_WINDOWS = ((0.0, 0.3), (0.0, 0.45), (0.0, 0.6), (0.1, 0.5), (0.2, 0.6), (0.3, 0.7))
 SURE_PUSH_PHASES, SURE_SETTLE_S, SURE_PUSH_M = 6, 5.0, 12.0
 SURE_PUSH_WINDOW = (0.42, 1.2)
 SURE_FALL_PENALTY, SURE_PUSH_PENALTY = 1.0, 2.0
+SURE_STEP_TOLERANCE, SURE_STEP_PENALTY = 0.01, 10.0
 # The "floquet" score of a walker whose orbit cannot be linearised: below any other walker's, and no
 # faller scores more (a faller's -9 + 8 * fraction walked stays below -1).
 FLOQUET_UNDEFINED = -1.0
@@ -512,9 +515,16 @@ def _hold_sure_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     early_falls = sum(not row["walked"] for row in early) / len(early)
     rows = [row for condition in pushes.values() for row in condition]
     push_falls = sum(not row["walked"] for row in rows) / len(rows)
-    value -= SURE_FALL_PENALTY * early_falls + SURE_PUSH_PENALTY * push_falls
+    quarter = _long_walk(config.override({"sim.time_step_s": 0.25 * config.sim.time_step_s}
+                                         ).replace(window=TorqueFreeWindow()))
+    if quarter["walked"]:
+        change = quarter["cost_of_transport"] / detail["long_bases"]["as_is"]["cost_of_transport"] - 1.0
+        step_cost = SURE_STEP_PENALTY * max(0.0, abs(change) - SURE_STEP_TOLERANCE)
+    else:
+        change, step_cost = None, 1.0
+    value -= SURE_FALL_PENALTY * early_falls + SURE_PUSH_PENALTY * push_falls + step_cost
     return value, {**detail, "early_windows": early, "steady_pushes": pushes, "early_falls": early_falls,
-                   "push_falls": push_falls}
+                   "push_falls": push_falls, "quarter_step": quarter, "quarter_step_change": change}
 
 
 def _hold_pull_score(config: EpisodeConfig, base: dict[str, Any], draws: int) -> tuple[float, dict[str, Any]]:
@@ -643,7 +653,7 @@ OBJECTIVES: dict[str, Objective] = {
     "hold-slow": Objective(_hold_slow_objective, True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
     "hold-edge": Objective(_hold_edge_objective, True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-lure": Objective(_hold_lure_objective, True, 'The "robust" objective first, then HOLD_LURE_WINDOWS (t1 0.40 to 0.46 s, the hip off until the foot lands) judged as in "hold-long", plus HOLD_LURE_WEIGHT x the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s: what brings GARB\'s means back from the no-window half of its start): least saving + 0.5 x that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
-    "hold-sure": Objective(_hold_sure_objective, True, 'The "hold-lure" score less SURE_FALL_PENALTY x the fraction of SURE_EARLY_WINDOWS (early windows, where GARB\'s first large steps can carry a mean) that fall over the 10 m episode, and less SURE_PUSH_PENALTY x the fraction of the +-PUSH_FORCE_N pushes in steady state (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a SURE_PUSH_M walk, as `push-margin` pushes; without a window and with SURE_PUSH_WINDOW) that fall.'),
+    "hold-sure": Objective(_hold_sure_objective, True, 'The "hold-lure" score less SURE_FALL_PENALTY x the fraction of SURE_EARLY_WINDOWS (early windows, where GARB\'s first large steps can carry a mean) that fall over the 10 m episode, and less SURE_PUSH_PENALTY x the fraction of the +-PUSH_FORCE_N pushes in steady state (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a SURE_PUSH_M walk, as `push-margin` pushes; without a window and with SURE_PUSH_WINDOW) that fall, and less SURE_STEP_PENALTY x how far the long-run C_mt of the walk without a window at a quarter of the plant step moves beyond SURE_STEP_TOLERANCE from the step\'s (1 when it falls).'),
     "hold-pull": Objective(_hold_pull_objective, True, 'The "hold-edge" score plus the mean reward gain over --policy-draws fixed draws of the paper\'s start policy ((0.5, 0.5), variance 0.04; the "expected" objective): where the learner\'s first episodes fall or save.'),
 }
 
