@@ -593,6 +593,21 @@ def test_a_failed_drake_check_in_a_dask_task_reaches_the_driver_as_a_drake_failu
         assert map_ordered(client, abs, [-2, 3]) == [2, 3]  # the worker lives on
 
 
+def _worker_log_level():
+    import logging
+
+    return logging.getLogger("distributed.worker").getEffectiveLevel()
+
+
+def test_the_local_clusters_workers_log_only_critical_lines(client):
+    """What a worker logs at ERROR while the cluster closes under it (a heartbeat to a scheduler already gone,
+    after Ctrl-C) would add lines to the one that says how to resume: the workers start with Dask's logging at
+    CRITICAL (the driver's own logging is left as it is)."""
+    import logging
+
+    assert client.submit(_worker_log_level, pure=False).result() == logging.CRITICAL
+
+
 def test_a_walk_on_a_level_part_longer_than_60_m_runs(tmp_path, capsys):
     # The issue's command: exit 1 with Drake's "Box(): width = -40.008" (the drawn ground stopped at 60 m).
     out = tmp_path / "w"

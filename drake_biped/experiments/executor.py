@@ -174,19 +174,26 @@ def _workers_ignore_ctrl_c() -> Iterator[None]:
 
 
 def _local_cluster(n: int):
+    import dask
     from distributed import LocalCluster
 
-    return LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        # The scheduler's HTTP endpoints (health, metrics) on a free port, not 8787: no clash, and no
-        # warning, when another cluster runs on the machine.
-        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
-        silence_logs=40,
-    )
+    # The worker processes log only what is critical (set in their environment before they start, as Dask
+    # reads its logging levels on import): a task's failure reaches the driver, which says it in one line, and
+    # what a worker logs at ERROR when the cluster closes under it (a heartbeat to a scheduler already gone,
+    # after Ctrl-C) is not a failure of the run.
+    environ = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), "DASK_LOGGING__DISTRIBUTED": "critical"}
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+        return LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            # The scheduler's HTTP endpoints (health, metrics) on a free port, not 8787: no clash, and no
+            # warning, when another cluster runs on the machine.
+            scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+            silence_logs=logging.ERROR,
+        )
 
 
 def peak_rss_mb() -> float:
