@@ -504,3 +504,33 @@ def test_hold_sure_takes_off_early_window_falls_steady_push_falls_and_the_quarte
     monkeypatch.setattr(gait_search, "_touchdowns", lambda config: (False, [0.5, 1.0]))  # falls unpushed
     value, detail = gait_search.OBJECTIVES["hold-sure"].score(EpisodeConfig(), base, (), 0)
     assert detail["push_falls"] == 1.0 and value == pytest.approx(0.5 - 1 / 6 - gait_search.SURE_PUSH_PENALTY - drift)
+
+
+def test_hold_fine_judges_the_walk_without_a_window_on_the_time_step_studys_ladder(monkeypatch):
+    """Fake walks: "hold-lure" scores 0.5, every early window and push walks; without a window the long-run C_mt
+    is 0.40 at the plant step, 0.388 at half of it (-3 % from the finest), 0.402 at a quarter and 0.40 at an
+    eighth: score = 0.5 - 10 x (0.03 - 0.01). When the eighth-step walk falls, the check costs 1."""
+    base = {"walked": True, "cost_of_transport": 0.5, "distance_m": 10.0, "reward": 2.0}
+    monkeypatch.setattr(gait_search, "_hold_lure_score",
+                        lambda config, b: (0.5, {"lure_saving": 0.3, "long_bases": {}}))
+    monkeypatch.setattr(gait_search, "_touchdowns", lambda config: (True, [0.5 * k for k in range(1, 30)]))
+    monkeypatch.setattr(gait_search, "_walk", lambda config: {"walked": True, "cost_of_transport": 0.3,
+                                                              "distance_m": 10.0})
+    step = EpisodeConfig().sim.time_step_s
+    cost = {1.0: 0.40, 0.5: 0.388, 0.25: 0.402, 0.125: 0.40}
+    ladder = []
+
+    def long_walk(config, distance_m):
+        fraction = round(config.sim.time_step_s / step, 4)
+        ladder.append((fraction, config.sim.control_period_s, config.window.end_s, distance_m))
+        return {"walked": fraction in cost, "cost_of_transport": cost.get(fraction)}
+
+    monkeypatch.setattr(gait_search, "_long_walk", long_walk)
+    value, detail = gait_search.OBJECTIVES["hold-fine"].score(EpisodeConfig(), base, (), 0)
+    period = EpisodeConfig().sim.control_period_s
+    assert ladder == [(f, period, 0.0, gait_search.FINE_STEP_M) for f in gait_search.FINE_STEP_FRACTIONS]
+    assert detail["step_ladder_changes"] == pytest.approx([0.0, -0.03, 0.005])
+    assert value == pytest.approx(0.5 - gait_search.SURE_STEP_PENALTY * (0.03 - gait_search.SURE_STEP_TOLERANCE))
+    del cost[0.125]
+    value, detail = gait_search.OBJECTIVES["hold-fine"].score(EpisodeConfig(), base, (), 0)
+    assert detail["step_ladder_changes"] is None and value == pytest.approx(0.5 - 1.0)
