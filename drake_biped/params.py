@@ -24,7 +24,7 @@ from drake_biped.paper import (
 __all__ = [
     "ContactParams", "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
-    "with_time_step", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "with_time_step", "walked_the_distance", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "RobotModel",
 ]
 
@@ -455,6 +455,12 @@ class ContactParams(_Validated):
 # value and SAP's near-rigid regime at its default threshold.
 DRAKE_DEFAULT_CONTACT = ContactParams(stiffness_npm=None, relaxation_time_s=None, hunt_crossley_dissipation_spm=None,
                                       sap_near_rigid_threshold=1.0)
+
+
+def walked_the_distance(fell: bool, distance_m: float, target_m: float) -> bool:
+    """Whether a walk that covered `distance_m`, falling or not, walked `target_m` (to 1 micrometre: the episode
+    ends on the control period at which the centre of mass passes it). Every experiment counts walkers by this."""
+    return (not fell) and distance_m >= target_m - 1e-6
 
 
 def with_time_step(sim: SimulationParams, time_step_s: float, option: str = "time_step_s") -> SimulationParams:

@@ -43,7 +43,14 @@ from drake_biped.experiments.options import (
     number,
     out_folder,
 )
-from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, check_settings, resolve_field
+from drake_biped.params import (
+    GRAVITY_MPS2,
+    EpisodeConfig,
+    ParameterError,
+    check_settings,
+    resolve_field,
+    walked_the_distance,
+)
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -123,7 +130,7 @@ def attractor_of_walk(result: dict[str, Any], distance_m: float, transient_m: fl
     times = np.array([s["touchdown_time_s"] for s in steps], dtype=float)
     com = np.array([s["com_x_m"] for s in steps], dtype=float)
     work = np.array([math.nan if s["positive_work_j"] is None else s["positive_work_j"] for s in steps], dtype=float)
-    fell = bool(result["fell"]) or result["distance_m"] < distance_m - 1e-6
+    fell = not walked_the_distance(result["fell"], result["distance_m"], distance_m)
     first = int(np.searchsorted(com - com[0], transient_m, side="left")) if len(com) else 0
     periods = np.diff(times[first:])
     sections = [[s["hip_angle_rad"], s["hip_rate_radps"]] for s in steps[first + 1:]]

@@ -41,7 +41,13 @@ from drake_biped.experiments.options import (
     episode_config,
     number,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
+from drake_biped.params import (
+    EpisodeConfig,
+    ParameterError,
+    TorqueFreeWindow,
+    check_settings,
+    walked_the_distance,
+)
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
@@ -226,7 +232,7 @@ def _walk(config: EpisodeConfig) -> dict[str, Any]:
 
     r = run_episode(config)
     return {
-        "walked": (not r.fell) and r.distance_m >= config.sim.distance_m - 1e-6,
+        "walked": walked_the_distance(r.fell, r.distance_m, config.sim.distance_m),
         "cost_of_transport": r.cost_of_transport,
         "distance_m": r.distance_m,
         "reward": reward(r.cost_of_transport, r.distance_m, config.sim.distance_m),
@@ -382,7 +388,7 @@ def _long_walk(config: EpisodeConfig, distance_m: float = HOLD_LONG_M) -> dict[s
 
     r = run_episode(config.override({"sim.distance_m": distance_m,
                                      "sim.max_time_s": max(config.sim.max_time_s, 6.0 * distance_m)}))
-    walked = (not r.fell) and r.distance_m >= distance_m - 1e-6
+    walked = walked_the_distance(r.fell, r.distance_m, distance_m)
     long_run = r.long_run(batches=4)
     return {"walked": walked, "distance_m": r.distance_m, "cost_of_transport": long_run["cost_of_transport"]
             if walked else None, "step_period_s": long_run["step_period_mean_s"],
@@ -483,7 +489,7 @@ def _touchdowns(config: EpisodeConfig) -> tuple[bool, list[float]]:
     from drake_biped.episode import run_episode
 
     r = run_episode(config)
-    return (not r.fell) and r.distance_m >= config.sim.distance_m - 1e-6, [s.touchdown_time_s for s in r.steps]
+    return walked_the_distance(r.fell, r.distance_m, config.sim.distance_m), [s.touchdown_time_s for s in r.steps]
 
 
 def _steady_push_rows(config: EpisodeConfig, window: tuple[float, float]) -> list[dict[str, Any]]:

@@ -40,7 +40,7 @@ from drake_biped.experiments.options import (
     print_lines,
 )
 from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
-from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError, check_settings
+from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError, check_settings, walked_the_distance
 from drake_biped.records import warn, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -293,7 +293,7 @@ def write_outputs(out: Path, base: EpisodeConfig, axes: list[Axis], points: list
     write_text_atomic(out / "grid.csv", text.getvalue())
     best_config = configs[best]
     write_atomic(out / "best_params.json", best_config)
-    walked = [r for r in rows if not r["fell"] and r["distance_m"] >= base.sim.distance_m - 1e-6]
+    walked = [r for r in rows if walked_the_distance(r["fell"], r["distance_m"], base.sim.distance_m)]
     record = {
         "base_config": base.to_dict(),
         "axes": [{"name": a.name, "values": list(a.values)} for a in axes],

@@ -50,7 +50,14 @@ from drake_biped.experiments.options import (
 from drake_biped.experiments.rewalk import changed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
-from drake_biped.params import EpisodeConfig, Ground, ParameterError, TorqueFreeWindow, check_settings
+from drake_biped.params import (
+    EpisodeConfig,
+    Ground,
+    ParameterError,
+    TorqueFreeWindow,
+    check_settings,
+    walked_the_distance,
+)
 from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -108,7 +115,7 @@ def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[st
 
 def climbs(result: dict[str, Any]) -> bool:
     """The episode reached its distance without falling."""
-    return bool((not result["fell"]) and result["distance_m"] >= result["config"]["sim"]["distance_m"] - 1e-6)
+    return walked_the_distance(result["fell"], result["distance_m"], result["config"]["sim"]["distance_m"])
 
 
 def _summary(result: dict[str, Any]) -> dict[str, Any]:
@@ -131,7 +138,7 @@ def trial_summary(episodes: list[dict[str, Any]], distance_m: float) -> dict[str
     d = np.array([e["distance_m"] for e in episodes])
     p = np.array([period(e["t1"], e["t2"]) for e in episodes])
     mean_p = np.array([period(e["mean_t1"], e["mean_t2"]) for e in episodes])
-    up = np.array([(not e["fell"]) and e["distance_m"] >= distance_m - 1e-6 for e in episodes])
+    up = np.array([walked_the_distance(e["fell"], e["distance_m"], distance_m) for e in episodes])
     n = min(MOVING_AVERAGE, len(episodes))
     ma = moving_average(d, MOVING_AVERAGE)
     # only a full window of MOVING_AVERAGE episodes counts: the first averages hold fewer

@@ -44,6 +44,7 @@ from drake_biped.params import (
     Push,
     TorqueFreeWindow,
     check_settings,
+    walked_the_distance,
 )
 from drake_biped.versions import versions
 
@@ -240,7 +241,7 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
 
 
 def survives(result: dict[str, Any], distance_m: float) -> bool:
-    return (not result["fell"]) and result["distance_m"] >= distance_m - 1e-6
+    return walked_the_distance(result["fell"], result["distance_m"], distance_m)
 
 
 def _section(result: dict[str, Any], index: int) -> np.ndarray | None:

@@ -41,6 +41,7 @@ from drake_biped.params import (
     ParameterError,
     TorqueFreeWindow,
     check_settings,
+    walked_the_distance,
     with_time_step,
 )
 from drake_biped.records import read_json, save_figure, write_text_atomic
@@ -79,7 +80,7 @@ def study(steps: list[float], reference: float, distance: float, client, progres
             "time_step_s": h,
             "control_period_s": c["sim"]["control_period_s"],
             "window": list(w) if w else None,
-            "walked": not r["fell"] and r["distance_m"] >= distance - 1e-6,
+            "walked": walked_the_distance(r["fell"], r["distance_m"], distance),
             "termination": r["termination"],
             "distance_m": r["distance_m"],
             "episode_cost_of_transport": r["cost_of_transport"],

@@ -22,7 +22,14 @@ from drake_biped.experiments.options import (
     out_folder,
     print_lines,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, Push, TorqueFreeWindow, check_settings
+from drake_biped.params import (
+    EpisodeConfig,
+    ParameterError,
+    Push,
+    TorqueFreeWindow,
+    check_settings,
+    walked_the_distance,
+)
 from drake_biped.records import warn, write_text_atomic
 
 
@@ -178,7 +185,7 @@ def long_run_lines(result) -> list[str]:
     (its C_mt is mostly the initiation's)."""
     from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
 
-    if result.fell or result.distance_m < TRANSIENT_M + LONG_RUN_M - 1e-6:
+    if not walked_the_distance(result.fell, result.distance_m, TRANSIENT_M + LONG_RUN_M):
         return []
     lr = result.long_run()
     if lr["cost_of_transport"] is None:

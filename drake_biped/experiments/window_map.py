@@ -26,7 +26,13 @@ from drake_biped.experiments.options import (
     out_folder,
     print_lines,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
+from drake_biped.params import (
+    EpisodeConfig,
+    ParameterError,
+    TorqueFreeWindow,
+    check_settings,
+    walked_the_distance,
+)
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
@@ -93,7 +99,7 @@ def window_row(config: dict[str, Any]) -> dict[str, Any]:
     return {
         "t1": c.window.start_s,
         "t2": c.window.end_s,
-        "walked": (not r.fell) and r.distance_m >= c.sim.distance_m - 1e-6,
+        "walked": walked_the_distance(r.fell, r.distance_m, c.sim.distance_m),
         "distance_m": r.distance_m,
         "fall_reason": r.fall_reason,
         "cost_of_transport": r.cost_of_transport,
