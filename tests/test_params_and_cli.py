@@ -18,7 +18,7 @@ from drake_biped.params import (
 
 
 def test_a_walk_has_walked_its_distance_only_to_it_and_without_a_fall():
-    assert walked_the_distance(False, 10.0 - 1e-9, 10.0)  # the centre of mass stops within a control period of it
+    assert walked_the_distance(False, 10.0 - 1e-9, 10.0)  # distance = com_x - com_x0, rounded
     assert not walked_the_distance(False, 9.99, 10.0)
     assert not walked_the_distance(True, 10.5, 10.0)  # a fall, however far it went
 

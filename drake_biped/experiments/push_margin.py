@@ -31,9 +31,9 @@ from drake_biped.experiments.options import (
     number,
     out_folder,
 )
-from drake_biped.experiments.stability import CONDITIONS, condition_window, survives
+from drake_biped.experiments.stability import CONDITIONS, condition_window
 from drake_biped.paper import PUSH_DURATION_S
-from drake_biped.params import EpisodeConfig, ParameterError, Push, check_settings
+from drake_biped.params import EpisodeConfig, ParameterError, Push, check_settings, walked_the_distance
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -119,8 +119,9 @@ def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, i
                            "distance_m": distance, "margins": {}}
     jobs, keys = [], []
     for condition, result in zip(CONDITIONS, unpushed):
-        step = steady_step(result, settings.settle_s) if survives(result, distance) else None
-        out["margins"][condition] = {"unpushed_walks": survives(result, distance),
+        walks = walked_the_distance(result["fell"], result["distance_m"], distance)
+        step = steady_step(result, settings.settle_s) if walks else None
+        out["margins"][condition] = {"unpushed_walks": walks,
                                      "step_s": None if step is None else list(step)}
         if step is None:
             continue
@@ -140,7 +141,7 @@ def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, i
                             "distance_m": [[None] * phases for _ in forces]}
     for (condition, direction, i, j), r in zip(keys, results):
         cell = out["margins"][condition][direction]
-        cell["survived"][i][j] = survives(r, distance)
+        cell["survived"][i][j] = walked_the_distance(r["fell"], r["distance_m"], distance)
         cell["distance_m"][i][j] = r["distance_m"]
     for m in out["margins"].values():
         for direction in ("forward", "backward"):

@@ -44,7 +44,6 @@ from drake_biped.params import (
     Push,
     TorqueFreeWindow,
     check_settings,
-    walked_the_distance,
 )
 from drake_biped.versions import versions
 
@@ -238,10 +237,6 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
         "cells": analyse(results, settings),
         "jacobian": jacobian,
     }
-
-
-def survives(result: dict[str, Any], distance_m: float) -> bool:
-    return walked_the_distance(result["fell"], result["distance_m"], distance_m)
 
 
 def _section(result: dict[str, Any], index: int) -> np.ndarray | None:
