@@ -157,6 +157,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
                if not r["fell"] and r["t2"] > max(0.0, r["t1"])]
     window = summaries["push_margin"]["settings"]["window"]
     assert summaries["stability"]["settings"]["window"] == window
+    assert summaries["time_step"]["settings"]["windows"][0] == window  # item 1's rule judges the learned window
     assert summaries["push_margin"]["window_source"].startswith("learned") == bool(learned)
     if not learned and summaries["window_map"]["best"] is not None:
         best = summaries["window_map"]["best"]
