@@ -115,8 +115,9 @@ def with_model(config: EpisodeConfig, model_file: str | None) -> EpisodeConfig:
     return config
 
 
-# The longest plant step at which the default gait's long-run C_mt stays within 1 % (or its interval) of the
-# finest step's (the time-step study, docs/RESULTS.md): 2 ms is 2.4 % off without a window, 5 % with one.
+# The longest plant step at which the default gait's long-run C_mt without a window stays within 1 % of the
+# finest step's (the time-step study, docs/RESULTS.md): 2 ms is 2.4 % off. The full run's learned window, whose
+# gait is chaotic, is 3.8 % low already at 1 ms (its saving 1.7 points high); docs/RESULTS.md says why 1 ms stays.
 CONVERGED_TIME_STEP_S = 0.001
 
 
