@@ -1,13 +1,14 @@
-"""Is a walk's step dependence in the contact? The same walks at two plant steps under several contact models.
+"""Is a walk's step dependence in the contact? The time-step study under several contact models.
 
-    python benchmarks/contact_ladder.py --out DIR                      # 16 walks of 110 m, about 3 min on 2 workers
+    python benchmarks/contact_ladder.py --out DIR                      # 16 walks of 110 m, about 4 min on 2 workers
     python benchmarks/contact_ladder.py --out DIR --windows 0.3-0.6 --steps 0.001,0.0005
 
-Walks the default gait without a window and with each of `--windows`, at each of `--steps` (control period
-kept), under each contact in CONTACTS: the shipped one (SAP, 1e6 N/m, relaxation time 0.1 s), SAP with a
-tenth of the relaxation time, SAP with a fifth of the stiffness, and Drake's "similar" approximation
-(Hunt & Crossley, 50 s/m). Prints and writes (DIR/contact_ladder.json, .md) each walk's long-run C_mt with its
-95 % interval and its step periods, and for each contact and walk the change from the finest step.
+Runs `drake-biped time-step-study`'s study (the default gait without a window and with each of `--windows`, at
+each of `--steps`, control period kept) once under each contact in CONTACTS: the shipped one (SAP, 1e6 N/m,
+relaxation time 0.1 s), SAP with a tenth of the relaxation time, SAP with a fifth of the stiffness, and Drake's
+"similar" approximation (Hunt & Crossley, 50 s/m). Each study is written as a time-step study of its own
+(DIR/<contact>/time_step_study.json, .md, .png); DIR/contact_ladder.md sets their changes from the finest step
+side by side.
 """
 
 import argparse
@@ -16,17 +17,19 @@ import json
 import time
 from pathlib import Path
 
-from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
-from drake_biped.experiments.executor import dask_client, episode_task, map_ordered
-from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, TorqueFreeWindow, with_time_step
+from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
+from drake_biped.experiments import time_step
+from drake_biped.experiments.executor import dask_client
+from drake_biped.params import EpisodeConfig
+from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions
 
-# (name, ContactParams fields replaced, contact approximation)
+# (folder, name, ContactParams fields replaced, contact approximation)
 CONTACTS = (
-    ("shipped (SAP)", {}, "sap"),
-    ("SAP, relaxation time 0.01 s", {"relaxation_time_s": 0.01}, "sap"),
-    ("SAP, 2e5 N/m", {"stiffness_npm": 2e5}, "sap"),
-    ("similar (Hunt & Crossley)", {}, "similar"),
+    ("shipped", "shipped (SAP)", {}, "sap"),
+    ("sap-relaxation-0.01", "SAP, relaxation time 0.01 s", {"relaxation_time_s": 0.01}, "sap"),
+    ("sap-2e5", "SAP, 2e5 N/m", {"stiffness_npm": 2e5}, "sap"),
+    ("similar", "similar (Hunt & Crossley)", {}, "similar"),
 )
 
 
@@ -43,62 +46,48 @@ def main() -> None:
     p.add_argument("--distance", type=float, default=TRANSIENT_M + LONG_RUN_M)
     p.add_argument("--workers", type=int, default=2)
     args = p.parse_args()
-    windows = [None, *(window_arg(w) for w in args.windows.split(",") if w)]
+    windows = [window_arg(w) for w in args.windows.split(",") if w]
     steps = sorted(float(h) for h in args.steps.split(","))
     base = EpisodeConfig()
-    jobs = []
-    for name, fields, approximation in CONTACTS:
-        for h in steps:
-            for w in windows:
-                sim = dataclasses.replace(with_time_step(base.sim, h, "--steps"), distance_m=args.distance,
-                                          max_time_s=6.0 * args.distance, contact_approximation=approximation)
-                config = base.replace(sim=sim, contact=dataclasses.replace(base.contact, **fields),
-                                      window=TorqueFreeWindow(*w) if w else TorqueFreeWindow(0.0, 0.0))
-                jobs.append((name, h, w, config.to_dict()))
-    t0 = time.perf_counter()
+    records = []
     with dask_client(workers=args.workers) as client:
-        results = map_ordered(client, episode_task, [j[3] for j in jobs])
-    rows = []
-    for (name, h, w, config), r in zip(jobs, results):
-        lr = long_run_of_record(r, GRAVITY_MPS2) if not r["fell"] else {}
-        rows.append({"contact": name, "time_step_s": h, "window": list(w) if w else None, "fell": r["fell"],
-                     "distance_m": r["distance_m"], "long_run": {k: v for k, v in lr.items()
-                                                                 if not isinstance(v, (list, dict))},
-                     "config": config})
-    args.out.mkdir(parents=True, exist_ok=True)
-    record = {"steps": steps, "windows": [list(w) if w else None for w in windows], "distance_m": args.distance,
-              "rows": rows, "versions": versions(), "wall_s": time.perf_counter() - t0,
-              "date": time.strftime("%Y-%m-%d %H:%M:%S %Z")}
-    (args.out / "contact_ladder.json").write_text(json.dumps(record, indent=1) + "\n")
-    text = markdown(record)
-    (args.out / "contact_ladder.md").write_text(text)
+        for folder, name, fields, approximation in CONTACTS:
+            config = base.replace(sim=dataclasses.replace(base.sim, contact_approximation=approximation),
+                                  contact=dataclasses.replace(base.contact, **fields))
+            t0 = time.perf_counter()
+            rec = time_step.study(steps, steps[0], args.distance, client, True, config, windows)
+            rec.update(gait=f"Default gait, contact: {name}", date=time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+                       versions=versions(), wall_s=time.perf_counter() - t0)
+            (args.out / folder).mkdir(parents=True, exist_ok=True)
+            write_text_atomic(args.out / folder / "time_step_study.json", json.dumps(rec, indent=2) + "\n")
+            time_step.replot(args.out / folder)
+            records.append((name, rec))
+    text = markdown(records)
+    write_text_atomic(args.out / "contact_ladder.md", text)
     print(text)
 
 
-def markdown(record: dict) -> str:
-    steps = record["steps"]
-    finest = steps[0]
+def markdown(records: list[tuple[str, dict]]) -> str:
+    """Each contact's walks: long-run C_mt ± 95 % and the change from the finest step, at every step."""
+    steps = records[0][1]["steps"]
     head = " | ".join(f"{1e3 * h:g} ms" for h in reversed(steps))
-    lines = [f"# The same walks under four contact models ({record['distance_m']:g} m, long-run C_mt ± 95 %)", "",
-             f"Change from the finest step ({1e3 * finest:g} ms) in brackets; step period mean ± standard deviation "
-             f"below each. Drake {record['versions'].get('drake')}, commit {record['versions'].get('git_commit')}.", "",
+    lines = [f"# The time-step study under four contact models ({records[0][1]['distance_m']:g} m walks)", "",
+             f"Long-run C_mt ± 95 %, change from the finest step ({1e3 * steps[0]:g} ms) in brackets. Each contact's "
+             "own study (step periods, real-time factors): its folder.", "",
              f"| contact | walk | {head} |", "|---|---|" + "---|" * len(steps)]
-    for name in dict.fromkeys(r["contact"] for r in record["rows"]):
-        for w in record["windows"]:
-            by = {r["time_step_s"]: r for r in record["rows"] if r["contact"] == name and r["window"] == w}
-            ref = by[finest]["long_run"].get("cost_of_transport")
+    for name, rec in records:
+        for w in rec["walks"]:
+            by = {r["time_step_s"]: r for r in rec["rows"] if r["window"] == w}
+            ref = by[steps[0]]["cost_of_transport"]
             cells = []
             for h in reversed(steps):
-                lr = by[h]["long_run"]
-                c = lr.get("cost_of_transport")
-                if by[h]["fell"] or c is None:
-                    cells.append(f"falls at {by[h]['distance_m']:.1f} m")
+                r = by[h]
+                if not r["walked"] or r["cost_of_transport"] is None:
+                    cells.append(f"falls at {r['distance_m']:.1f} m")
                     continue
-                change = f" ({100 * (c / ref - 1):+.1f} %)" if ref else ""
-                cells.append(f"{c:.4f} ± {lr['half_width']:.4f}{change}<br>"
-                             f"{lr['step_period_mean_s']:.3f} ± {lr['step_period_std_s']:.3f} s")
-            walk = "no window" if w is None else f"{w[0]:g}–{w[1]:g} s"
-            lines.append(f"| {name} | {walk} | " + " | ".join(cells) + " |")
+                change = f" ({100 * (r['cost_of_transport'] / ref - 1):+.1f} %)" if ref else ""
+                cells.append(f"{r['cost_of_transport']:.4f} ± {r['half_width']:.4f}{change}")
+            lines.append(f"| {name} | {time_step.label(w)} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
