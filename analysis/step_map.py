@@ -115,7 +115,7 @@ class SectionMap:
         self._integrated = config.gait.swing_reading == "integrated"
         self._parts = build_diagram(config)
         self._simulator = Simulator(self._parts.diagram)
-        self._dt = config.sim.control_period_s
+        self._dt = config.sim.update_period_s
         self._max_step_s = max_step_s
         self.template: Snapshot | None = None
 

@@ -157,7 +157,7 @@ DIVERGED_CODE = 5
 
 def touchdown_capacity(config: EpisodeConfig) -> int:
     """Rows reserved for touchdowns: enough for the whole episode at the shortest accepted step."""
-    shortest = max(config.gait.touchdown_min_step_s, config.sim.control_period_s)
+    shortest = max(config.gait.touchdown_min_step_s, config.sim.update_period_s)
     return min(MAX_TOUCHDOWNS, int(math.ceil(config.sim.max_time_s / shortest)) + 1)
 
 
@@ -165,7 +165,7 @@ def touchdown_capacity(config: EpisodeConfig) -> int:
 # The episode's numbers as the compiled update takes them: one vector, packed by law_vector() into the context's
 # numeric parameter when an episode is set (`set_episode`), read in the kernel through the constants below.
 LAW = VectorLayout("law", (
-    Field("control_period_s", 1, "dt"),
+    Field("update_period_s", 1, "the controller's update period (s): the plant step under the paper's clock, else the fixed-rate loop's"),
     Field("state_lag_s", 1, "the plant step: the state read at update time t is the state at t + lag"),
     Field("alpha", 1, "CPG alpha"), Field("u_a", 1, "CPG u_a"), Field("u_eta", 1, "CPG u_eta"),
     Field("u_r", 1, "CPG u_r"), Field("kappa", 1, "CPG kappa"),
@@ -185,7 +185,7 @@ LAW = VectorLayout("law", (
     Field("fall_hip_height_m", 1, ""), Field("fall_pitch_rad", 1, ""),
 ))
 _o = LAW.offset
-L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("control_period_s", "state_lag_s", "alpha", "u_a",
+L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("update_period_s", "state_lag_s", "alpha", "u_a",
                                                                     "u_eta", "u_r", "kappa"))
 L_AMPLITUDE, L_INTEGRATED, L_PREDICTED, L_OFFSET = (_o(n) for n in ("swing_amplitude_rad", "integrated",
                                                                    "predicted_swap", "swing_offset_rad"))
@@ -209,7 +209,7 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     def put(name: str, value) -> None:
         v[LAW.slice(name)] = value
 
-    put("control_period_s", sim.control_period_s)
+    put("update_period_s", sim.update_period_s)
     put("state_lag_s", sim.time_step_s)
     for name in ("alpha", "u_a", "u_eta", "u_r", "kappa"):
         put(name, getattr(c, name))
@@ -568,13 +568,13 @@ class CpgWalkingController(LeafSystem):
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
         self.DeclareStateOutputPort("actuation", self._torque_group)
         self.DeclareStateOutputPort("controller_state", self._state_group)
-        self.DeclarePeriodicDiscreteUpdateEvent(config.sim.control_period_s, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(config.sim.update_period_s, 0.0, self._update)
 
     @staticmethod
     def structure_key(config: EpisodeConfig) -> tuple:
         """What the system's ports, state sizes and update period are built from."""
         sim = config.sim
-        return (config.ground, sim.time_step_s, sim.control_period_s, sim.max_time_s, config.gait.touchdown_min_step_s)
+        return (config.ground, sim.time_step_s, sim.update_period_s, sim.max_time_s, config.gait.touchdown_min_step_s)
 
     def set_episode(self, context, config: EpisodeConfig) -> None:
         """Put the per-episode numbers (CPG, gait, window, fall thresholds) of `config` into this system's

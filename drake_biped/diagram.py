@@ -110,7 +110,7 @@ def build_diagram(
         builder.Connect(push.get_output_port(), plant.get_applied_spatial_force_input_port())
     logs: dict[str, VectorLogSink] = {}
     if record:
-        period = log_period_s or config.sim.control_period_s
+        period = log_period_s or config.sim.update_period_s
         for name, port in (
             ("state_log", plant.get_state_output_port()),
             ("controller_log", controller.get_output_port_controller_state()),
@@ -147,7 +147,7 @@ def build_replay_diagram(
     builder = DiagramBuilder()
     plant = add_biped(builder, config.ground, config.sim.time_step_s, config.model,
                       contact_approximation=config.sim.contact_approximation, contact=config.contact).plant
-    breaks = np.append(times, times[-1] + config.sim.control_period_s)
+    breaks = np.append(times, times[-1] + config.sim.update_period_s)
     hold = PiecewisePolynomial.ZeroOrderHold(breaks, np.vstack([torques, torques[-1:]]).T)
     source = builder.AddNamedSystem("logged_torques", TrajectorySource(hold))
     builder.Connect(source.get_output_port(), plant.get_actuation_input_port())

@@ -309,7 +309,7 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     plant_ctx = plant.GetMyMutableContextFromRoot(root)
     ctrl_ctx = controller.GetMyMutableContextFromRoot(root)
     h = config.sim.time_step_s
-    every = int(round(config.sim.control_period_s / h))
+    every = int(round(config.sim.update_period_s / h))
     x = plant_ctx.get_discrete_state(0).get_value()
     s = ctrl_ctx.get_mutable_discrete_state(controller.state_group).get_mutable_value()
     tau = ctrl_ctx.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
@@ -387,7 +387,7 @@ def run_episode(
         fall_reason = (f"the control loop diverged: {ctl.DIVERGED_REVERSALS} torque reversals of more than "
                        f"{ctl.REVERSAL_FACTOR:g} x a motor's limit within {ctl.DIVERGENCE_SPAN_PERIODS} control "
                        f"periods ({int(s.torque_reversals)} in all; the control period "
-                       f"{config.sim.control_period_s:g} s is too long for the servos)")
+                       f"{config.sim.update_period_s:g} s is too long for the servos)")
     else:
         fall_reason = ctl.FALL_REASONS.get(fall_code, "") if reason == "fall" else ("" if not fell else reason)
 

@@ -24,7 +24,7 @@ from drake_biped.paper import (
 __all__ = [
     "ContactParams", "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
-    "with_time_step", "walked_the_distance", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "RobotModel",
 ]
 
@@ -386,10 +386,17 @@ class Ground(_Validated):
 
 @dataclass(frozen=True)
 class SimulationParams(_Validated):
-    """Plant time step, controller rate and episode limits."""
+    """Plant time step, the controller's clock and episode limits.
+
+    The controller's clock is part of the model. `control_period_s` None (the default) is the paper's reading:
+    ODE's joint motors act inside every simulation step, so the controller updates at every plant step and its
+    limit, as the step is refined, is a continuous controller; refining the step refines both. A number is a
+    fixed-rate loop, a property of the robot ("its loop runs at 1/control_period_s Hz"): the plant step is refined
+    under it, and it must be a whole multiple of the step. A record holds both the reading and the rate
+    (`to_dict`: "controller_clock" and "update_period_s")."""
 
     time_step_s: float = 1e-3
-    control_period_s: float = 1e-3
+    control_period_s: float | None = None
     distance_m: float = 10.0
     max_time_s: float = 60.0
     # Fall: hip below this height above the ground, or torso pitch beyond this angle.
@@ -409,6 +416,9 @@ class SimulationParams(_Validated):
     }
 
     CONTACT_APPROXIMATIONS = ("sap", "similar", "lagged", "tamsi")
+    # The two readings of the controller's clock, as records name them.
+    PLANT_STEP_CLOCK = "plant step"
+    FIXED_RATE_CLOCK = "fixed rate"
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -417,12 +427,32 @@ class SimulationParams(_Validated):
                 f"SimulationParams.contact_approximation = {self.contact_approximation!r} is not one of "
                 f"{list(self.CONTACT_APPROXIMATIONS)}"
             )
-        ratio = self.control_period_s / self.time_step_s
-        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
-            raise ParameterError(
-                f"SimulationParams.control_period_s = {self.control_period_s!r} must be a whole multiple "
-                f"of time_step_s = {self.time_step_s!r}"
-            )
+        if self.control_period_s is not None:
+            ratio = self.control_period_s / self.time_step_s
+            if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+                raise ParameterError(
+                    f"SimulationParams.control_period_s = {self.control_period_s!r} must be a whole multiple "
+                    f"of time_step_s = {self.time_step_s!r} (or None: the controller acts at every plant step)"
+                )
+
+    @property
+    def clock(self) -> str:
+        """The controller's clock: PLANT_STEP_CLOCK (the paper's reading) or FIXED_RATE_CLOCK."""
+        return self.PLANT_STEP_CLOCK if self.control_period_s is None else self.FIXED_RATE_CLOCK
+
+    @property
+    def update_period_s(self) -> float:
+        """The period (s) at which the controller updates: the plant step, or the fixed-rate loop's period."""
+        return self.time_step_s if self.control_period_s is None else self.control_period_s
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**super().to_dict(), "controller_clock": self.clock, "update_period_s": self.update_period_s}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any] | None, where: str | None = None):
+        if isinstance(data, Mapping):  # the clock's reading and rate are derived: recorded, not parameters
+            data = {k: v for k, v in data.items() if k not in ("controller_clock", "update_period_s")}
+        return super().from_dict(data, where)
 
 
 @dataclass(frozen=True)
@@ -464,18 +494,35 @@ def walked_the_distance(fell: bool, distance_m: float, target_m: float) -> bool:
 
 
 def with_time_step(sim: SimulationParams, time_step_s: float, option: str = "time_step_s") -> SimulationParams:
-    """`sim` with the plant step `time_step_s` and its control period kept: the controller is a digital
-    controller of a fixed rate, part of the robot, not a numerical knob. A step longer than the control period
-    makes the control period the step (the controller cannot run faster than the plant is stepped).
-    ParameterError naming `option` when the control period is not a whole multiple of the step."""
-    control = sim.control_period_s
-    if time_step_s >= control:
-        control = time_step_s
-    ratio = control / time_step_s
-    if abs(ratio - round(ratio)) > 1e-6:
-        raise ParameterError(f"{option} {time_step_s!r}: the control period {control!r} s is not a whole multiple "
-                             "of it")
-    return dataclasses.replace(sim, time_step_s=time_step_s, control_period_s=control)
+    """`sim` at the plant step `time_step_s`, its controller's clock kept. Under the paper's clock (the
+    controller at every plant step) the controller is refined with the plant. A fixed-rate loop is part of the
+    robot, not a numerical knob: its period is kept, and a step that does not divide it (or is longer) is
+    refused with a ParameterError naming `option`."""
+    if sim.control_period_s is not None:
+        ratio = sim.control_period_s / time_step_s
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise ParameterError(f"{option} {time_step_s!r}: the controller's fixed-rate loop of "
+                                 f"{sim.control_period_s!r} s is not a whole multiple of it")
+    return dataclasses.replace(sim, time_step_s=time_step_s)
+
+
+def clock_of_record(sim: Mapping[str, Any]) -> tuple[str, float]:
+    """The controller's clock (reading, update period in s) of a record's "sim" section. A record written before
+    the clock was part of the model names a control period: the fixed-rate loop it ran on."""
+    if "controller_clock" in sim:
+        return sim["controller_clock"], float(sim["update_period_s"])
+    period = sim.get("control_period_s")
+    if period is None:
+        return SimulationParams.PLANT_STEP_CLOCK, float(sim["time_step_s"])
+    return SimulationParams.FIXED_RATE_CLOCK, float(period)
+
+
+def clock_text(sim: Mapping[str, Any]) -> str:
+    """The clock of a record's "sim" section in words, for reports."""
+    reading, period = clock_of_record(sim)
+    if reading == SimulationParams.PLANT_STEP_CLOCK:
+        return f"the controller acts at every plant step ({1e3 * period:g} ms), the paper's reading"
+    return f"the controller a fixed-rate loop of {1e3 * period:g} ms ({1.0 / period:g} Hz)"
 
 
 MODEL_FORMATS = {".urdf": "urdf", ".sdf": "sdf"}
@@ -574,6 +621,12 @@ class EpisodeConfig(_Validated):
             raise ParameterError(f"Push.start_s = {self.push.start_s!r} is at or after the time limit "
                                  f"sim.max_time_s = {self.sim.max_time_s!r}: the push would never act")
 
+    def to_dict(self) -> dict[str, Any]:
+        """The record of this configuration: each section as its own `to_dict` gives it (the simulation's with
+        the controller's clock), the seed, and the model's record or None."""
+        return {f.name: (v.to_dict() if hasattr(v, "to_dict") else v)
+                for f in fields(self) for v in (getattr(self, f.name),)}
+
     def replace(self, **changes: Any) -> EpisodeConfig:
         """A copy with whole sections (or the seed) replaced: `config.replace(window=TorqueFreeWindow(0.2, 0.5))`."""
         return dataclasses.replace(self, **changes)
@@ -609,12 +662,20 @@ def check_settings(settings: Any, cls: type, where: str) -> None:
 
 
 def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:
-    """The EpisodeConfig of a result record's "config": as `EpisodeConfig.from_dict`, except that a record
-    written before the contact was recorded (no "contact" section) ran on DRAKE_DEFAULT_CONTACT, and is walked
-    again on it."""
+    """The EpisodeConfig of a result record's "config": as `EpisodeConfig.from_dict`, except for two kinds of
+    record written before a choice was recorded:
+    - no "contact" section: it ran on DRAKE_DEFAULT_CONTACT, and is walked again on it;
+    - no "controller_clock" in its "sim", with the control period equal to the plant step: its walk is the same
+      under either clock, and it is read with the paper's (the controller at every plant step), so that a
+      re-walk at another step refines the controller with the plant, as today's records do. A control period
+      that differs from the step is the fixed-rate loop that record ran on, and is kept."""
     config = EpisodeConfig.from_dict(data, where)
     if isinstance(data, Mapping) and "contact" not in data:
         config = config.replace(contact=DRAKE_DEFAULT_CONTACT)
+    sim = data.get("sim") if isinstance(data, Mapping) else None
+    if isinstance(sim, Mapping) and "controller_clock" not in sim and \
+            config.sim.control_period_s == config.sim.time_step_s:
+        config = config.replace(sim=dataclasses.replace(config.sim, control_period_s=None))
     return config
 
 

@@ -121,21 +121,21 @@ def test_gate_zeroes_swing_hip_and_freezes_integrator():
     integral_at_start = None
     t = 0.0
     while t < 0.2:
-        t = round(t + config.sim.control_period_s, 9)
+        t = round(t + config.sim.update_period_s, 9)
         sim.AdvanceTo(t)
         tau = c.get_output_port_actuation().Eval(ctx)
         s = c.state(ctx)
         # the torque now held was computed at t - dt and acts over [elapsed, elapsed + dt) after T_n = 0,
         # in plant-state time (the update reads the state one time step ahead)
-        elapsed = t - config.sim.control_period_s + config.sim.time_step_s
-        inside = window.start_s <= elapsed + 1e-9 and elapsed + config.sim.control_period_s <= window.end_s + 1e-9
+        elapsed = t - config.sim.update_period_s + config.sim.time_step_s
+        inside = window.start_s <= elapsed + 1e-9 and elapsed + config.sim.update_period_s <= window.end_s + 1e-9
         if inside:
             assert tau[swing_hip] == 0.0
             assert s.torque_free == 1.0
             integral_at_start = s.hip_integral if integral_at_start is None else integral_at_start
             assert s.hip_integral == integral_at_start
             seen_in += 1
-        elif elapsed >= window.end_s - 1e-9 or elapsed + config.sim.control_period_s <= window.start_s + 1e-9:
+        elif elapsed >= window.end_s - 1e-9 or elapsed + config.sim.update_period_s <= window.start_s + 1e-9:
             assert abs(tau[swing_hip]) > 0.1
             assert s.torque_free == 0.0
             seen_out += 1
@@ -156,7 +156,7 @@ def test_integrated_reading_drives_the_swing_by_zeta_unscaled():
     q = x[:9]
     thigh = q[2] + q[3]  # the left (swing) thigh's world angle
     liftoff = c.state(ctx).liftoff_angle_rad
-    dt = config.sim.control_period_s
+    dt = config.sim.update_period_s
     travel = 0.0
     swing_hip = joint_index("left", "hip")
     read = 0
@@ -184,8 +184,9 @@ def test_the_phase_reading_decides_what_swaps_the_legs(gait, reading):
     from drake_biped.resources import load_gait
 
     config = (EpisodeConfig() if gait is None else load_gait(gait)).override({"sim.distance_m": 3.0})
-    if gait == "paper_entrained":  # it falls in its first step at a 1 ms plant step and walks at 0.5 ms (the
-        config = config.override({"sim.time_step_s": 5e-4})  # control period kept): the reading is what is tested
+    if gait == "paper_entrained":  # it falls in its first step at 1 ms, and at 0.5 ms under the paper's clock;
+        # it walks at 0.5 ms under a 1 kHz loop: the reading is what is tested
+        config = config.override({"sim.time_step_s": 5e-4, "sim.control_period_s": 1e-3})
     assert config.gait.phase_reading == reading
     r = run_episode(config, record_trajectory=True, cache=None)
     T = r.trajectory

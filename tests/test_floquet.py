@@ -297,7 +297,7 @@ def test_floquet_command_writes_its_record(tmp_path):
     assert "#### Floquet multipliers of the periodic orbit (no torque-free period)" in section
     assert f"{record['spectral_radius']:.4f}" in section and "floquet_without/floquet.png" in section
     # the sampling-phase sentence names the record's own control period
-    half = {**record, "config": {**record["config"], "sim": {**record["config"]["sim"], "control_period_s": 5e-4}}}
+    half = {**record, "config": {**record["config"], "sim": {**record["config"]["sim"], "update_period_s": 5e-4}}}
     assert "the phase of the 0.5 ms control update" in floquet.markdown(half)
 
 

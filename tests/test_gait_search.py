@@ -522,13 +522,13 @@ def test_hold_fine_judges_the_walk_without_a_window_on_the_time_step_studys_ladd
 
     def long_walk(config, distance_m):
         fraction = round(config.sim.time_step_s / step, 4)
-        ladder.append((fraction, config.sim.control_period_s, config.window.end_s, distance_m))
+        ladder.append((fraction, config.sim.update_period_s, config.window.end_s, distance_m))
         return {"walked": fraction in cost, "cost_of_transport": cost.get(fraction)}
 
     monkeypatch.setattr(gait_search, "_long_walk", long_walk)
     value, detail = gait_search.OBJECTIVES["hold-fine"].score(EpisodeConfig(), base, (), 0)
-    period = EpisodeConfig().sim.control_period_s
-    assert ladder == [(f, period, 0.0, gait_search.FINE_STEP_M) for f in gait_search.FINE_STEP_FRACTIONS]
+    # the paper's clock: each rung refines the controller with the plant
+    assert ladder == [(f, f * step, 0.0, gait_search.FINE_STEP_M) for f in gait_search.FINE_STEP_FRACTIONS]
     assert detail["step_ladder_changes"] == pytest.approx([0.0, -0.03, 0.005])
     assert value == pytest.approx(0.5 - gait_search.SURE_STEP_PENALTY * (0.03 - gait_search.SURE_STEP_TOLERANCE))
     del cost[0.125]

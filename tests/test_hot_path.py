@@ -49,7 +49,7 @@ def test_touchdown_records_are_the_logged_section_states(short_walk):
     minus trailing thigh) interpolated there between the two logged states, its rate extrapolated there
     from the two logged states before them (before the impact), the centre of mass of the update."""
     T = short_walk.trajectory
-    dt = _config().sim.control_period_s
+    dt = _config().sim.update_period_s
     assert len(short_walk.steps) >= 3
     backs = []
     for step in short_walk.steps:
@@ -80,7 +80,7 @@ def _swap_residuals(walk):
     T_n, less the blend of the period before it (the old roles) and the period after it (the new roles) by
     the part of the period before T_n; and the jump between those two periods."""
     T = walk.trajectory
-    dt = _config().sim.control_period_s
+    dt = _config().sim.update_period_s
     a = T["actuation"][:, [0, 1, 3, 4]]
     rows = []
     for step in walk.steps[1:]:
@@ -105,7 +105,7 @@ def test_the_roles_swap_at_the_crossing_inside_the_control_period(short_walk):
 def test_episode_ends_at_the_update_that_walks_the_distance(short_walk):
     """The controller stops the run at the first control update with the centre of mass past the
     target: the distance overshoots by at most one control period of walking."""
-    dt = _config().sim.control_period_s
+    dt = _config().sim.update_period_s
     assert 3.0 <= short_walk.distance_m < 3.0 + 2.0 * dt  # well under 2 m/s
     T = short_walk.trajectory
     com = np.array([center_of_mass(q)[0] for q in T["positions"][-3:]]) - center_of_mass(T["positions"][0])[0]

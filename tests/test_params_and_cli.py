@@ -117,3 +117,43 @@ def test_every_experiment_owns_its_command_in_one_shape():
         names.add(module.COMMAND)
     commands = next(a for a in cli.build_parser()._actions if a.dest == "command").choices
     assert names <= set(commands) and {"bifurcation", "basins"} <= names
+
+
+def test_the_controller_clock_is_the_plant_step_by_default_and_every_record_names_it():
+    """The paper's clock (ODE's motors act inside every step): the controller's update period is the plant step,
+    refined with it; a fixed-rate loop is a number kept over the step; a record holds the reading and the rate;
+    an older record's control period is the fixed-rate loop it ran on."""
+    from drake_biped.controller import L_DT, law_vector
+    from drake_biped.params import clock_of_record, with_time_step
+
+    config = EpisodeConfig().override({"sim.time_step_s": 2.5e-4})
+    assert config.sim.clock == "plant step" and config.sim.update_period_s == 2.5e-4
+    assert law_vector(config)[L_DT] == 2.5e-4  # the kernel integrates at the plant step
+    record = config.to_dict()["sim"]
+    assert (record["controller_clock"], record["update_period_s"]) == ("plant step", 2.5e-4)
+    assert EpisodeConfig.from_dict(config.to_dict()) == config
+    fixed = EpisodeConfig().override({"sim.control_period_s": 1e-3})
+    half = with_time_step(fixed.sim, 5e-4)
+    assert (half.clock, half.update_period_s) == ("fixed rate", 1e-3)
+    assert clock_of_record(fixed.replace(sim=half).to_dict()["sim"]) == ("fixed rate", 1e-3)
+    with pytest.raises(ParameterError, match="time_step_s 0.002"):
+        with_time_step(fixed.sim, 2e-3)
+    old = {"time_step_s": 5e-4, "control_period_s": 1e-3}  # a record from before the clock was recorded
+    assert clock_of_record(old) == ("fixed rate", 1e-3)
+    assert EpisodeConfig.from_dict({"sim": old}).sim.update_period_s == 1e-3
+    from drake_biped.params import config_of_record
+
+    # a record from before: its loop at its own step reads as the paper's clock; a slower loop stays fixed
+    legacy = {"sim": {"time_step_s": 1e-3, "control_period_s": 1e-3}, "contact": {}}
+    assert config_of_record(legacy).sim.clock == "plant step"
+    assert config_of_record({"sim": old, "contact": {}}).sim.update_period_s == 1e-3
+    assert config_of_record(fixed.to_dict()).sim.clock == "fixed rate"  # a record that names its clock
+
+
+def test_the_control_period_option_must_divide_the_plant_step(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["walk", "--out", str(tmp_path / "w"), "--time-step", "0.0004", "--control-period", "0.001"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--control-period 0.001" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "w").exists()

@@ -52,7 +52,9 @@ def test_the_changes_halve_the_plant_step_and_scale_the_initiation_speed():
     config = EpisodeConfig()
     half = changed(config, "half_step")
     assert half.sim.time_step_s == 0.5 * config.sim.time_step_s
-    assert half.sim.control_period_s == config.sim.control_period_s  # the 1 kHz controller is the robot's
+    assert half.sim.update_period_s == half.sim.time_step_s  # the paper's clock: the controller refined with it
+    fixed = config.override({"sim.control_period_s": 1e-3})  # a robot's 1 kHz loop is kept
+    assert changed(fixed, "half_step").sim.update_period_s == 1e-3
     assert changed(config, "speed_0.95").initial.speed_mps == pytest.approx(0.95 * config.initial.speed_mps)
     assert changed(config, "speed_1.05").initial.speed_mps == pytest.approx(1.05 * config.initial.speed_mps)
     assert changed(config, "as_learned") == config

@@ -77,10 +77,42 @@ def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
     assert len(seen) == 6
     assert {c["cpg"]["u_r"] for c in seen} == {gait.cpg.u_r}
     assert {c["gait"]["torso_pitch_rad"] for c in seen} == {gait.gait.torso_pitch_rad}
-    assert sorted({(c["sim"]["time_step_s"], c["sim"]["control_period_s"]) for c in seen}) == [
-        (0.0005, 0.0005), (0.001, 0.001)]
+    # the paper's clock: the controller refined with the plant, and each record says so
+    assert sorted({(c["sim"]["time_step_s"], c["sim"]["update_period_s"], c["sim"]["controller_clock"])
+                   for c in seen}) == [(0.0005, 0.0005, "plant step"), (0.001, 0.001, "plant step")]
     assert {(c["window"]["start_s"], c["window"]["end_s"]) for c in seen} == {(0.0, 0.0), (0.3, 0.7), (0.5, 1.0)}
     assert rec["walks"] == [None, [0.3, 0.7], [0.5, 1.0]] and rec["chosen_step_s"] == 0.001
     rec.update(gait="Gait coasting_wide", versions={"git_commit": "x", "drake": "y"}, date="d")
     table = time_step.markdown(rec)
     assert "Gait coasting_wide" in table and "| window 0.5–1 s |" in table and "0.2–0.5" not in table
+
+
+def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp_path, capsys):
+    """A robot's 1 kHz loop stays 1 kHz at every plant step of the study; a step that does not divide it is
+    refused before any walk, and the default steps are those that divide it."""
+    from drake_biped.experiments import time_step
+    from drake_biped.params import EpisodeConfig
+
+    seen = []
+
+    def fake_map(client, fn, items, on_result=None):
+        seen.extend(items)
+        return [{"fell": False, "distance_m": 10.0, "termination": "distance", "mass_kg": 10.0,
+                 "cost_of_transport": 0.6, "steps": [], "mean_speed_mps": 1.0, "step_period_s": 0.4,
+                 "real_time_factor": 5.0} for _ in items]
+
+    monkeypatch.setattr(time_step, "map_ordered", fake_map)
+    fixed = EpisodeConfig().override({"sim.control_period_s": 1e-3})
+    time_step.study([0.00025, 0.0005, 0.001], 0.00025, 10.0, None, progress=False, config=fixed, windows=[])
+    assert sorted({(c["sim"]["time_step_s"], c["sim"]["update_period_s"], c["sim"]["controller_clock"])
+                   for c in seen}) == [(0.00025, 0.001, "fixed rate"), (0.0005, 0.001, "fixed rate"),
+                                       (0.001, 0.001, "fixed rate")]
+    with pytest.raises(SystemExit) as exc:
+        main(["time-step-study", "--out", str(tmp_path / "x"), "--control-period", "0.001",
+              "--steps", "0.002,0.001"])
+    assert exc.value.code == 2 and "--steps 0.002" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+    from drake_biped.cli import build_parser
+
+    args = build_parser().parse_args(["time-step-study", "--out", str(tmp_path / "y"), "--control-period", "0.001"])
+    assert time_step.settings_from_args(args).steps == (0.001, 0.0005, 0.00025, 0.000125)

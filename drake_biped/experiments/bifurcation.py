@@ -111,13 +111,12 @@ class BifurcationSettings:
 
 def point_config(settings: BifurcationSettings, value: float, time_step_s: float) -> EpisodeConfig:
     """The walk of one point: the settings' gait with the parameter at `value`, at plant step `time_step_s`
-    (the control period kept, as everywhere)."""
+    (the controller's clock kept: refined with the plant under the paper's clock, a fixed-rate loop kept)."""
     from drake_biped.params import with_time_step
 
     config = settings.config.override({settings.param: float(value)})
     if time_step_s != config.sim.time_step_s:
-        sim = with_time_step(config.sim, time_step_s, "--second-time-step")
-        config = config.override({"sim.time_step_s": sim.time_step_s, "sim.control_period_s": sim.control_period_s})
+        config = config.replace(sim=with_time_step(config.sim, time_step_s, "--second-time-step"))
     return config
 
 

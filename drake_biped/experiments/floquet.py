@@ -33,7 +33,7 @@ from drake_biped.experiments.options import (
     out_folder,
     positive_list,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, check_settings
+from drake_biped.params import EpisodeConfig, ParameterError, check_settings, clock_of_record
 from drake_biped.records import write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -317,7 +317,7 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
     if d.get("continued"):
         lines.append("| walk continued | " + " | ".join(f"{v:.2e}" for v in d["continued"]) + " |")
     if record.get("sampling_phase_drift"):
-        period_ms = 1e3 * record["config"]["sim"]["control_period_s"]
+        period_ms = 1e3 * clock_of_record(record["config"]["sim"])[1]
         lines += ["", "The fixed point walked on without restarting the update grid drifts from itself by "
                   + ", ".join(f"{v:.1e}" for v in record["sampling_phase_drift"])
                   + f" per step: the gait's sensitivity to the phase of the {period_ms:g} ms control update, "

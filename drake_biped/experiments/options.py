@@ -5,6 +5,7 @@ and the value; the episode options that build an EpisodeConfig; the window optio
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from contextlib import contextmanager
@@ -82,8 +83,9 @@ def add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False)
     p.add_argument("--max-time", type=number("positive"),
                    help="simulated time limit (s) (default: 60, or 6 s per metre of --distance if longer)")
     p.add_argument("--time-step", type=number("positive"),
-                   help="plant time step (s) (default: 0.001); the control period (1 ms) is kept, or becomes the "
-                        "step when the step is longer")
+                   help="plant time step (s) (default: 0.001); the controller acts at every step (the paper's "
+                        "clock) unless --control-period fixes its rate")
+    add_clock_option(p)
     if slope_command:
         p.add_argument("--slope", type=number("finite"), required=True,
                        help="the ascending slope after the level part (rad, > 0)")
@@ -95,6 +97,29 @@ def add_episode_options(p: argparse.ArgumentParser, slope_command: bool = False)
                        help="level ground for this many metres, then the slope (default: none, the slope everywhere)")
     p.add_argument("--seed", type=seed_type, default=None, help="recorded with the result (default: 0)")
     add_model_option(p)
+
+
+def add_clock_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--control-period", type=number("positive"),
+                   help="the controller as a fixed-rate loop of this period (s), a whole multiple of the plant "
+                        "step: a robot whose loop runs at 1/PERIOD Hz (default: the controller acts at every plant "
+                        "step, as the paper's ODE motors do, or the --params file's clock)")
+
+
+def with_clock(config: EpisodeConfig, time_step_s: float | None, control_period_s: float | None) -> EpisodeConfig:
+    """`config` at the --time-step and with the --control-period given (None: kept), checked together and named
+    by option: a fixed-rate loop must be a whole multiple of the plant step."""
+    if control_period_s is not None:
+        step = config.sim.time_step_s if time_step_s is None else time_step_s
+        ratio = control_period_s / step
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise ParameterError(f"--control-period {control_period_s!r}: not a whole multiple of the plant step "
+                                 f"{step!r} s")
+        config = config.replace(sim=dataclasses.replace(config.sim, time_step_s=step,
+                                                        control_period_s=control_period_s))
+    if time_step_s is not None:
+        config = config.replace(sim=with_time_step(config.sim, time_step_s, "--time-step"))
+    return config
 
 
 def add_model_option(p: argparse.ArgumentParser) -> None:
@@ -129,14 +154,12 @@ def episode_config(args: argparse.Namespace) -> EpisodeConfig:
         changes["sim.max_time_s"] = max(config.sim.max_time_s, 6.0 * args.distance)
     if args.max_time is not None:
         changes["sim.max_time_s"] = args.max_time
-    if args.time_step is not None:
-        sim = with_time_step(config.sim, args.time_step, "--time-step")
-        changes["sim.time_step_s"], changes["sim.control_period_s"] = sim.time_step_s, sim.control_period_s
     if args.slope is not None:
         changes["ground.slope_rad"] = args.slope
     if args.level_length is not None:
         changes["ground.level_length_m"] = args.level_length
-    config = with_model(config.override(changes), args.model)
+    config = with_clock(config.override(changes), args.time_step, args.control_period)
+    config = with_model(config, args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
         print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
               "steps at which the default gait's walk converges (docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its "

@@ -46,8 +46,8 @@ def window_of(sample) -> TorqueFreeWindow:
 
 
 def changed(config: EpisodeConfig, change: str) -> EpisodeConfig:
-    """`config` under one of CHANGES: the plant step halved (the control period kept), or the initiation speed
-    scaled."""
+    """`config` under one of CHANGES: the plant step halved (with it the controller under the paper's clock; a
+    fixed-rate loop kept), or the initiation speed scaled."""
     if change == "as_learned":
         return config
     if change == "half_step":

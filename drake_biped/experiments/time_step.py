@@ -1,8 +1,10 @@
 """Time-step study: the convergence of a gait's long-run cost of transport as the plant step is halved.
 
 Each walk (no window and each window given; by default the default gait's learned window and a window early
-in the swing) goes LONG_WALK_M from the paper's initiation at every plant step, the control period kept (the
-controller is part of the robot; a step longer than it makes the control period the step). A walk's C_mt is
+in the swing) goes LONG_WALK_M from the paper's initiation at every plant step. The controller's clock is the
+gait's: under the paper's reading (the controller acts at every plant step) plant and controller are refined
+together; a fixed-rate loop (`--control-period`) is part of the robot and kept, the plant step alone refined
+under it (steps that do not divide it are refused). A walk's C_mt is
 its long-run mean after the initiation's transient (analysis.long_run: the first 10 m dropped, the next 100 m
 measured, with a 95 % interval from batch means). From the three finest steps, a Richardson estimate gives
 each walk's limit as the step goes to 0 and each step's error. The shipped step is the coarsest whose long-run
@@ -27,20 +29,24 @@ from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.experiments.options import (
     add_cluster_options,
+    add_clock_option,
     add_model_option,
     cluster,
     number,
     out_folder,
     steps,
     windows,
+    with_clock,
     with_model,
 )
 from drake_biped.params import (
     GRAVITY_MPS2,
     EpisodeConfig,
+    SimulationParams,
     ParameterError,
     TorqueFreeWindow,
     check_settings,
+    clock_of_record,
     walked_the_distance,
     with_time_step,
 )
@@ -79,7 +85,7 @@ def study(steps: list[float], reference: float, distance: float, client, progres
         long_run = _long_run(r)
         rows.append({
             "time_step_s": h,
-            "control_period_s": c["sim"]["control_period_s"],
+            "control_period_s": clock_of_record(c["sim"])[1],
             "window": list(w) if w else None,
             "walked": walked_the_distance(r["fell"], r["distance_m"], distance),
             "termination": r["termination"],
@@ -216,14 +222,20 @@ def markdown(rec: dict) -> str:
         limit = f"{e['limit']:.4f}" + (" (noise-dominated)" if e.get("noise_dominated") else "")
         rich_lines.append(f"| {label(w)} | {limit} | {order} | " + " | ".join(errs) + " |")
     control = sorted({(r["time_step_s"], r.get("control_period_s")) for r in rec["rows"]})
+    reading = clock_of_record(rec["config"]["sim"])[0]
+    if reading == SimulationParams.PLANT_STEP_CLOCK:
+        clock = ("The controller acts at every plant step (the paper's reading), so plant and controller are refined "
+                 "together: " + ", ".join(f"{h * 1e3:g} ms" for h, c in control) + ".")
+    else:
+        clock = ("The controller is a fixed-rate loop, part of the robot, so the plant step alone is refined under it; "
+                 "control period at each step: " + ", ".join(f"{h * 1e3:g} ms → {c * 1e3:g} ms" for h, c in control
+                                                              if c is not None) + ".")
     lines = [
         "# Time-step study: the long-run cost of transport as the plant step is halved",
         "",
         f"{rec.get('gait', 'Default gait')}, {rec['distance_m']:g} m walks from the paper's initiation; C_mt is the "
         f"long-run mean after the first {TRANSIENT_M:g} m, with its 95 % interval (batch means over steps); "
-        f"reference {rec['reference_s'] * 1e3:g} ms. Control period at each step: "
-        + ", ".join(f"{h * 1e3:g} ms → {c * 1e3:g} ms" for h, c in control if c is not None)
-        + f". Contact: {_contact_text(rec['config'])}. Commit {rec['versions']['git_commit']}, "
+        f"reference {rec['reference_s'] * 1e3:g} ms. {clock} Contact: {_contact_text(rec['config'])}. Commit {rec['versions']['git_commit']}, "
         f"Drake {rec['versions']['drake']}, {rec['date']}.",
         "",
         f"**Chosen step: {chosen * 1e3:g} ms**, the coarsest with the long-run C_mt of every walk that walks at "
@@ -312,6 +324,9 @@ class TimeStepSettings:
     windows: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
+        sim = (self.config or EpisodeConfig()).sim
+        for h in self.steps:  # a fixed-rate loop is refined over the plant step alone: each step must divide it
+            with_time_step(sim, h, "--steps")
         if self.reference_s not in self.steps:
             raise ParameterError(f"--reference {self.reference_s!r} must be one of --steps {sorted(self.steps)}")
         for t1, t2 in self.windows or ():
@@ -351,14 +366,16 @@ def replot(out: Path) -> dict:
 
 # The command line: `drake-biped time-step-study` (drake_biped/cli.py runs `command`).
 COMMAND = "time-step-study"
-PARSER = dict(help="the long-run C_mt against the plant step (control period kept), "
+PARSER = dict(help="the long-run C_mt against the plant step (the controller's clock refined with it, or a "
+              "fixed-rate loop kept), "
               "Richardson's limit, and the step they choose")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped time-step-study`'s options."""
-    p.add_argument("--steps", type=steps, default=list(STEPS),
-                   help="plant steps (s), comma-separated (default 0.002,0.001,0.0005,0.00025,0.000125)")
+    p.add_argument("--steps", type=steps, default=None,
+                   help="plant steps (s), comma-separated (default 0.002,0.001,0.0005,0.00025,0.000125, or those of "
+                   "them that divide a fixed-rate loop's period)")
     p.add_argument("--reference", type=number("positive"), default=None,
                    help="reference step (s), one of --steps (default: the finest)")
     p.add_argument("--distance", type=number("positive"), default=LONG_WALK_M,
@@ -367,6 +384,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
                    "default gait. Its own time step is replaced by each of --steps")
     add_model_option(p)
+    add_clock_option(p)
     p.add_argument("--windows", type=windows,
                    help="the windows compared with none, T1-T2 in s, comma-separated (default "
                    "0.3672-0.8629,0.3-0.6: the default gait's learned window and one early in the swing)")
@@ -382,8 +400,14 @@ def settings_from_args(args: argparse.Namespace) -> TimeStepSettings:
     config = None if args.params is None else load_gait(args.params)
     if args.model is not None:
         config = with_model(config or EpisodeConfig(), args.model)
-    reference = min(args.steps) if args.reference is None else args.reference
-    return TimeStepSettings(tuple(args.steps), reference, args.distance, config,
+    if args.control_period is not None:
+        config = with_clock(config or EpisodeConfig(), None, args.control_period)
+    chosen = args.steps
+    if chosen is None:
+        period = (config or EpisodeConfig()).sim.control_period_s
+        chosen = [h for h in STEPS if period is None or abs(period / h - round(period / h)) <= 1e-6]
+    reference = min(chosen) if args.reference is None else args.reference
+    return TimeStepSettings(tuple(chosen), reference, args.distance, config,
                             "Default gait" if args.params is None else f"Gait {args.params}",
                             None if args.windows is None else tuple(args.windows))
 
