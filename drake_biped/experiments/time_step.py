@@ -28,8 +28,8 @@ from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_r
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.experiments.options import (
-    add_cluster_options,
     add_clock_option,
+    add_cluster_options,
     add_model_option,
     cluster,
     number,
@@ -42,8 +42,8 @@ from drake_biped.experiments.options import (
 from drake_biped.params import (
     GRAVITY_MPS2,
     EpisodeConfig,
-    SimulationParams,
     ParameterError,
+    SimulationParams,
     TorqueFreeWindow,
     check_settings,
     clock_of_record,
