@@ -24,6 +24,20 @@ _T975 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 
          11: 2.201, 12: 2.179, 13: 2.160, 14: 2.145, 15: 2.131, 16: 2.120, 17: 2.110, 18: 2.101, 19: 2.093}
 
 
+def has_long_run(distance_m: float, transient_m: float = TRANSIENT_M) -> bool:
+    """Whether a walk of `distance_m` is long enough for a long-run mean: the transient and LONG_RUN_M beyond it."""
+    return distance_m >= transient_m + LONG_RUN_M - 1e-9
+
+
+def measure_text(distance_m: float, transient_m: float = TRANSIENT_M) -> str:
+    """What the C_mt of walks of `distance_m` is, in words, as a report states it: the long-run mean after the
+    transient where the walks are long enough (`has_long_run`), else the whole walk's."""
+    if has_long_run(distance_m, transient_m):
+        return f"{distance_m:g} m walks, C_mt the long-run mean after the first {transient_m:g} m"
+    return (f"{distance_m:g} m walks, C_mt over the whole walk (a long-run mean needs "
+            f"{transient_m + LONG_RUN_M:g} m)")
+
+
 def t975(df: int) -> float:
     """The two-sided 95 % quantile of Student's t with `df` degrees of freedom (1.96 beyond 19)."""
     return _T975.get(int(df), 1.96)

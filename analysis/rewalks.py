@@ -15,7 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from drake_biped.analysis.series import signed_percent
+from drake_biped.analysis.long_run import measure_text
+from drake_biped.analysis.series import signed_percent, window_text
 
 __all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary"]
 
@@ -80,20 +81,22 @@ def _change(saving: float | None) -> str:
 def markdown(record: dict[str, Any]) -> str:
     """The re-walks as a table: each trial's saving (C_mt change against no window) under each change."""
     words = [CHANGE_WORDS[c] for c in record["changes"]]
+    clock = record.get("controller_clock")
+    clock = ("" if clock is None else "; the controller at every plant step, halved with it" if clock == "plant step"
+             else f"; the controller a fixed-rate loop of {1e3 * record['update_period_s']:g} ms, kept")
     lines = [f"Each learned window re-walked: {', '.join(words)}; each against the walk without a window "
-             f"under the same change (plant step {1e3 * record['time_step_s']:g} ms, initiation "
+             f"under the same change (plant step {1e3 * record['time_step_s']:g} ms{clock}, initiation "
              f"{record['speed_mps']:g} m/s"
-             + (f"; {record['distance_m']:g} m walks, C_mt the long-run mean after the first 10 m" if
-                record.get("distance_m") else "")
+             + (f"; {measure_text(record['distance_m'])}" if record.get("distance_m") else "")
              + f"). A trial holds when it saves ≥ {100 * record['hold_saving']:.0f} % in every walk.", "",
-             "| trial | window (s) | " + " | ".join(words) + " | mean | holds |",
+             "| trial | window | " + " | ".join(words) + " | mean | holds |",
              "|---|---|" + "---:|" * len(words) + "---:|---|"]
     base = " | ".join(f"C_mt {measured_cost(r):.4f}" if not r["fell"] and measured_cost(r) else "falls"
                       for r in record["no_window"].values())
     lines.append(f"| no window | — | {base} | | |")
     for t in record["trials"]:
         cells = " | ".join(_change(t["savings"][c]) for c in record["changes"])
-        lines.append(f"| {t['trial']} | {max(0.0, t['t1']):.3f}–{max(0.0, t['t2']):.3f} | {cells} | "
+        lines.append(f"| {t['trial']} | {window_text(t['t1'], t['t2'])} | {cells} | "
                      f"{_change(t['mean_saving'])} | "
                      f"{'yes' if t['holds'] else 'no'} |")
     lines += ["", headline(record)]

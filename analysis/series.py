@@ -29,6 +29,14 @@ def period(t1: float, t2: float) -> float:
     return float(max(0.0, max(0.0, t2) - max(0.0, t1)))
 
 
+def window_text(t1: float, t2: float, digits: int = 3) -> str:
+    """A (t1, t2) sample or mean as the window it walks, in words: "0.367–0.863 s", or "none (t2 <= t1)" when
+    it gives no torque-free period (times below 0 act as 0)."""
+    if period(t1, t2) <= 0.0:
+        return f"none (t2 {t2:.{digits}f} <= t1 {t1:.{digits}f})"
+    return f"{max(0.0, t1):.{digits}f}–{max(0.0, t2):.{digits}f} s"
+
+
 def signed_percent(fraction: float | None, digits: int = 1) -> str:
     """A fraction as a signed percentage ("+12.3 %", "-4.0 %"); one that rounds to zero prints "0.0 %", never
     "-0.0 %"; None prints "—"."""

@@ -159,37 +159,6 @@ def build_parser() -> argparse.ArgumentParser:
 _GROWABLE = {"learn": ("episodes", "trials"), "compare-learners": ("episodes", "trials"),
              "gait-search": ("generations",), "slope": ("episodes", "trials"), "stability": ("trials",)}
 
-# The largest runs a command starts without --force, counted in what it walks: every size a user gives is bounded
-# before any work (a day or more of 2 cores; the grid, the window map and the push-margin map have their own).
-MAX_RUN_EPISODES = 100_000
-_RUN_SIZES = {
-    "learn": ("episodes", lambda a: a.trials * a.episodes, "--trials x --episodes"),
-    "compare-learners": ("episodes", lambda a: len(a.learners) * a.trials * a.episodes,
-                         "learners x --trials x --episodes"),
-    "slope": ("episodes", lambda a: a.trials * a.episodes, "--trials x --episodes"),
-    "stability": ("episodes", lambda a: 6 * a.trials, "6 cells x --trials"),
-    "gait-search": ("candidates", lambda a: a.generations * a.offspring, "--generations x --offspring"),
-    "time-step-study": ("walks", lambda a: len(a.steps) * (1 + (len(a.windows) if a.windows else 2)),
-                        "--steps x walks"),
-}
-MAX_RUN_SIZE = {"episodes": MAX_RUN_EPISODES, "candidates": 2_000, "walks": 200}
-
-
-def _check_run_size(args: argparse.Namespace) -> None:
-    """ParameterError naming the options, the count and its limit when a run is larger than MAX_RUN_SIZE,
-    unless --force."""
-    if args.command not in _RUN_SIZES or getattr(args, "force", False):
-        return
-    unit, size, options = _RUN_SIZES[args.command]
-    try:
-        n = size(args)
-    except (AttributeError, TypeError):
-        return
-    if n > MAX_RUN_SIZE[unit]:
-        raise ParameterError(f"{options} = {n:,} {unit}, more than the limit of {MAX_RUN_SIZE[unit]:,} for one run; "
-                             "give fewer, or --force to run it anyway")
-
-
 # What does not change a run's records: where it runs and how it reports. Every other option is part of the
 # settings an output folder is held for (records.claim_folder).
 _NOT_SETTINGS = {"out", "workers", "scheduler", "force", "debug", "overwrite", "func", "command", "replot"}
@@ -247,7 +216,6 @@ def main(argv: list[str] | None = None) -> int:
     again = ("run the same command again to resume: finished work is kept in " + str(out)
              if args.command in RESUMABLE and out else "run the same command again")
     with _failures_as_one_line(f"drake-biped {args.command}", debug, again):
-        _check_run_size(args)
         with _holding_the_out_folder(args):
             return args.func(args)
     return 0  # not reached: a failure leaves by SystemExit

@@ -21,7 +21,7 @@ import numpy as np
 
 from drake_biped.jit import njit
 from drake_biped.layout import Field, VectorLayout
-from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
+from drake_biped.paper import HIP_LIMIT_RAD, TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
 from drake_biped.params import CONTACT_RADIUS_M, EFFORT_LIMITS_NM, HEEL_X_M, SOLE_DEPTH_M, TOE_X_M
 
 THIGH_M = TABLE_I_LENGTHS_M["thigh"]
@@ -116,6 +116,18 @@ B_M_TORSO, B_M_THIGH, B_M_SHANK, B_M_FOOT, B_M_TOTAL = _b("torso_kg"), _b("thigh
     _b("total_kg")
 B_HIP_EFFORT, B_KNEE_EFFORT, B_ANKLE_EFFORT = _b("hip_effort_nm"), _b("knee_effort_nm"), _b("ankle_effort_nm")
 del _b
+
+
+def longest_step_m(body: np.ndarray, hip_limit_rad: float = HIP_LIMIT_RAD) -> float:
+    """An upper bound on a step's length (m): the ankles of two straight legs whose thighs are each within the
+    hips' range of the torso (Table I: +-51 deg), so at most 2 x 51 deg apart. The centre of mass advances by
+    at most n times it, plus a leg's length, by its n-th touchdown: a shorter walk may end before it."""
+    return float(2.0 * leg_length_m(body) * math.sin(min(hip_limit_rad, 0.5 * math.pi)))
+
+
+def leg_length_m(body: np.ndarray) -> float:
+    """Hip to ankle with the knee straight (m)."""
+    return float(math.hypot(body[B_KNEE_X], body[B_KNEE_Z]) + math.hypot(body[B_ANKLE_X], body[B_ANKLE_Z]))
 
 
 def com_on_segment(com_xz, joint_xz) -> tuple[float, float, float]:

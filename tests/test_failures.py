@@ -38,7 +38,8 @@ def files(tmp_path):
                        "unknown.json": '{"cpg": {"u_q": 1}}', "range.json": '{"cpg": {"alpha": 9}}',
                        "spec_bad.yaml": "axes: [", "spec_axis.yaml": "axes: {nope: {values: [1]}}",
                        "notamap.json": '{"config": {}}', "a_file": "x",
-                       "spec_big.yaml": "axes: {u_a: {min: 1, max: 2, points: 400}, u_r: {min: 3, max: 5, points: 400}}"
+                       "spec_big.yaml": "axes: {u_a: {min: 1, max: 2, points: 400}, u_r: {min: 3, max: 5, points: 400}}",
+                       "spec_noop.yaml": "axes: {t1: {values: [0.1, 0.2]}, u_a: {values: [2.3, 2.4]}}"
                        }.items():
         (tmp_path / name).write_text(text)
         f[name] = str(tmp_path / name)
@@ -108,6 +109,21 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
     (["learn", "--workers", "1000", "--out", "{tmp}/l"],
      ["--workers 1000: more local worker processes than this machine holds (limit ", "per core", "--force"]),
     (["window-map", "--workers", "100000", "--out", "{tmp}/wm"], ["--workers 100000", "--force"]),
+    (["landscape", "{tmp}/none", "--samples", "1000000000", "--out", "{tmp}/ls"],
+     ["--samples 1,000,000,000", "GiB in memory"]),
+    # input that cannot give an answer, refused before any walk
+    (["stability", "--trials", "2", "--distance", "3", "--out", "{tmp}/s"],
+     ["--distance 3", "needs touchdown 6", "walk at least"]),
+    (["time-step-study", "--steps", "0.002,0.001", "--distance", "3", "--out", "{tmp}/t"],
+     ["--distance 3", "long-run means", "110 m"]),
+    (["time-step-study", "--steps", "0.001,0.001", "--out", "{tmp}/t"], ["--steps 0.001,0.001", "twice"]),
+    # options that change nothing
+    (["bifurcation", "--param", "t1", "--from", "0.2", "--to", "0.3", "--num", "2", "--out", "{tmp}/b"],
+     ["--param t1 --from 0.2 --to 0.3", "never opens", "--t2"]),
+    (["bifurcation", "--param", "u_a", "--from", "2", "--to", "2.5", "--num", "2", "--second-time-step", "0.001",
+      "--out", "{tmp}/b"], ["--second-time-step 0.001", "same result"]),
+    (["grid", "--spec", "{file:spec_noop.yaml}", "--out", "{tmp}/g"], ["axis window.start_s", "changes nothing"]),
+    (["walk", "--level-length", "2", "--out", "{tmp}/w"], ["--level-length 2", "changes nothing"]),
 ]
 
 
@@ -219,7 +235,11 @@ def _api_cases():
     import numpy as np
 
     import drake_biped as db
+    from drake_biped.experiments.bifurcation import BifurcationSettings
     from drake_biped.experiments.gait_search import GaitSearchSettings
+    from drake_biped.experiments.grid import Axis, GridSettings
+    from drake_biped.experiments.landscape import LandscapeSettings
+    from drake_biped.experiments.learning import LearningSettings
     from drake_biped.experiments.stability import StabilitySettings
     from drake_biped.experiments.time_step import TimeStepSettings
     from drake_biped.experiments.window_map import WindowMapSettings
@@ -242,6 +262,15 @@ def _api_cases():
         (lambda: StabilitySettings(window=(0.5, 0.2)), db.ParameterError, "need 0 <= t1 < t2"),
         (lambda: GaitSearchSettings(generations=0), db.ParameterError, "generations (0)"),
         (lambda: db.EpisodeConfig(push=db.Push(20.0, start_s=70.0)), db.ParameterError, "would never act"),
+        # the API bounds sizes and refuses what cannot answer or changes nothing, as the command line does
+        (lambda: LandscapeSettings("m", samples=10**9), db.ParameterError, "GiB in memory"),
+        (lambda: LandscapeSettings("m", variances=(float("nan"),)), db.ParameterError, "--variance"),
+        (lambda: LearningSettings(trials=10, episodes=10**6), db.ParameterError, "10,000,000 episodes"),
+        (lambda: TimeStepSettings(distance_m=3.0), db.ParameterError, "long-run means"),
+        (lambda: StabilitySettings(config=db.EpisodeConfig().override({"sim.distance_m": 3.0})).check_walks_reach(),
+         db.ParameterError, "needs touchdown 6"),
+        (lambda: BifurcationSettings(param="t1", values=(0.2, 0.3)), db.ParameterError, "never opens"),
+        (lambda: GridSettings(axes=(Axis("window.start_s", (0.1, 0.2)),)), db.ParameterError, "changes nothing"),
     ]
 
 

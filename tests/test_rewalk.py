@@ -38,7 +38,7 @@ def test_a_saving_is_judged_against_no_window_under_the_same_change():
     assert record["holding"] == 1
     assert "1 of 3 trials save ≥ 35 % in every walk" in headline(record)
     table = markdown(record)
-    assert "| 1 | 0.100–0.500 | -50.0 % | falls | -50.0 % | -50.0 % | -50.0 % | no |" in table
+    assert "| 1 | 0.100–0.500 s | -50.0 % | falls | -50.0 % | -50.0 % | -50.0 % | no |" in table
     assert "| no window | — | C_mt 0.2000 | C_mt 0.2500 | C_mt 0.2000 | C_mt 0.1000 | | |" in table
 
 

@@ -194,11 +194,15 @@ def test_foreign_records_are_named_not_a_key_error(tmp_path):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["learn", "--trials", "1000", "--episodes", "1000"], "--trials x --episodes = 1,000,000 episodes"),
-    (["slope", "--slope", "0.02", "--trials", "2000", "--episodes", "100"], "--trials x --episodes = 200,000"),
-    (["stability", "--trials", "20000"], "6 cells x --trials = 120,000 episodes"),
-    (["gait-search", "--generations", "1000", "--offspring", "8"], "--generations x --offspring = 8,000"),
-    (["compare-learners", "--window-map", "m", "--trials", "100", "--episodes", "500"], "learners x --trials x --episodes = 150,000"),
+    (["learn", "--trials", "1000", "--episodes", "1000"], "--trials 1000 x --episodes 1000: 1,000,000 episodes"),
+    (["slope", "--slope", "0.02", "--trials", "2000", "--episodes", "100"], "--trials 2000 x --episodes 100: 200,000"),
+    (["stability", "--trials", "20000"], "--trials 20000: 120,000 walks"),
+    (["gait-search", "--generations", "1000", "--offspring", "8"], "--generations 1000 x --offspring 8: 8,000"),
+    (["compare-learners", "--window-map", "m", "--trials", "100", "--episodes", "500"],
+     "--learners garb,cmaes,pgpe x --trials 100 x --episodes 500: 150,000"),
+    (["landscape", "m", "--samples", "1000000"], "--samples 1,000,000 x 3 variances: 3,000,000 draws"),
+    (["time-step-study", "--steps", ",".join(f"{1e-3 + k * 1e-6:.6g}" for k in range(700))],
+     "--steps (700) x walks (3): 2,100 walks"),
 ])
 def test_every_size_a_user_gives_is_bounded_before_any_work(tmp_path, capsys, argv, words):
     with pytest.raises(SystemExit) as e:

@@ -28,7 +28,7 @@ from drake_biped.experiments.options import (
     out_folder,
 )
 from drake_biped.experiments.stability import CONDITIONS, condition_window
-from drake_biped.params import EpisodeConfig, ParameterError, check_settings
+from drake_biped.params import LEARNED_WINDOW_S, EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -43,7 +43,7 @@ class BasinSettings:
 
     config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 30.0,
                                                                                     "sim.max_time_s": 180.0}))
-    window: tuple[float, float] = (0.2, 0.5)
+    window: tuple[float, float] = LEARNED_WINDOW_S
     hip_angles_rad: tuple[float, ...] = (0.10, 0.13, 0.16)
     speeds_mps: tuple[float, ...] = (0.15, 0.175, 0.20)
     transient_m: float = TRANSIENT_M
@@ -221,7 +221,7 @@ def settings_from_args(args: argparse.Namespace) -> BasinSettings:
     config = episode_config(args)
     if args.distance is None:
         config = config.override({"sim.distance_m": 30.0, "sim.max_time_s": max(config.sim.max_time_s, 180.0)})
-    return BasinSettings(config, chosen_window(args), tuple(args.hip_angles), tuple(args.speeds),
+    return BasinSettings(config, chosen_window(args, config), tuple(args.hip_angles), tuple(args.speeds),
                          transient_m=args.transient, force=args.force)
 
 

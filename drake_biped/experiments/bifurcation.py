@@ -36,8 +36,10 @@ from drake_biped.analysis.attractor import (
 )
 from drake_biped.analysis.long_run import TRANSIENT_M, long_run_cost
 from drake_biped.experiments.options import (
+    EPISODE_RECORD_BYTES,
     add_cluster_options,
     add_episode_options,
+    check_memory,
     count,
     episode_config,
     number,
@@ -98,6 +100,18 @@ class BifurcationSettings:
                                  f"{self.config.sim.distance_m:g} m")
         if self.walks > MAX_WALKS and not self.force:
             raise ParameterError(f"bifurcation: {self.walks} walks is above {MAX_WALKS}; lower --num, or give --force")
+        check_memory(f"--num {len(self.values)}", self.walks * EPISODE_RECORD_BYTES)
+        if self.second_time_step_s is not None and self.second_time_step_s == self.config.sim.time_step_s:
+            raise ParameterError(f"--second-time-step {self.second_time_step_s:g} is the gait's own plant step: it "
+                                 "walks every value again to the same result")
+        walked = [self.config.override({self.param: float(v)}).as_walked() for v in self.values]
+        if len(self.values) > 1 and all(w == walked[0] for w in walked):
+            span = f"--param {self.param} --from {min(self.values):g} --to {max(self.values):g}"
+            if not any(w.window.active for w in walked):
+                raise ParameterError(f"{span}: the torque-free window never opens at any value (t2 <= t1 at each), so "
+                                     "every value walks the same episode without one; give --t2 (or --t1) so that "
+                                     "a window opens")
+            raise ParameterError(f"{span}: every value walks the same episode; this parameter changes nothing here")
 
     @property
     def time_steps(self) -> tuple[float, ...]:

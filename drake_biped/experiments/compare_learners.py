@@ -22,6 +22,7 @@ from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.options import (
     add_episode_options,
     add_resumable_run_options,
+    check_learning_size,
     cluster,
     count,
     episode_config,
@@ -49,6 +50,16 @@ class CompareSettings:
     mean: tuple[float, float] = GARB_MEAN_S
     variance: float = GARB_VARIANCE_S2
     reuse: dict[str, str] = field(default_factory=dict)  # learner name: folder of a longer run to replay
+    force: bool = False  # run more than MAX_EPISODES episodes over all learners
+
+    def __post_init__(self) -> None:
+        if not self.learners:
+            raise ParameterError("--learners: name at least one learner")
+        for name, value in (("--trials", self.trials), ("--episodes", self.episodes)):
+            if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+                raise ParameterError(f"{name} {value!r}: must be an integer >= 1")
+        check_learning_size(f"--learners {','.join(self.learners)} x --trials {self.trials} x --episodes "
+                            f"{self.episodes}", len(self.learners) * self.trials * self.episodes, self.force)
 
     def map_path(self) -> Path:
         source = Path(self.window_map)
@@ -189,7 +200,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def settings_from_args(args: argparse.Namespace) -> CompareSettings:
     """The comparison's settings from the command's options."""
     return CompareSettings(episode_config(args), args.window_map, learners=tuple(args.learners), trials=args.trials,
-                           episodes=args.episodes, seed=args.seed if args.seed is not None else 0)
+                           episodes=args.episodes, seed=args.seed if args.seed is not None else 0, force=args.force)
 
 
 def command(args: argparse.Namespace) -> int:

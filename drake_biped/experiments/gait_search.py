@@ -34,8 +34,12 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.experiments.options import (
+    EPISODE_RECORD_BYTES,
+    MAX_CANDIDATES,
     add_episode_options,
     add_resumable_run_options,
+    check_memory,
+    check_size,
     cluster,
     count,
     episode_config,
@@ -735,6 +739,7 @@ class GaitSearchSettings:
     mutations: str = "default"
     objective: str = "windows"
     policy_draws: int = POLICY_DRAWS
+    force: bool = False  # more than MAX_CANDIDATES candidates
 
     def __post_init__(self) -> None:
         if self.mutations not in MUTATION_SETS:
@@ -748,6 +753,9 @@ class GaitSearchSettings:
                 f"({self.policy_draws!r}) must be >= 1, "
                 f"sigma ({self.sigma!r}) and distance_m ({self.distance_m!r}) > 0"
             )
+        check_size(f"--generations {self.generations} x --offspring {self.offspring}",
+                   self.generations * self.offspring, MAX_CANDIDATES, "candidates", self.force)
+        check_memory(f"--policy-draws {self.policy_draws}", self.policy_draws * EPISODE_RECORD_BYTES)
 
 
 def _search_start(settings: GaitSearchSettings) -> EpisodeConfig:
@@ -981,7 +989,7 @@ def settings_from_args(args: argparse.Namespace) -> GaitSearchSettings:
     return GaitSearchSettings(
         config, generations=args.generations, offspring=args.offspring, sigma=args.sigma, seed=config.seed,
         distance_m=config.sim.distance_m if args.distance is not None else 6.0, mutations=args.mutations,
-        objective=args.objective, policy_draws=args.policy_draws)
+        objective=args.objective, policy_draws=args.policy_draws, force=args.force)
 
 
 def command(args: argparse.Namespace) -> int:

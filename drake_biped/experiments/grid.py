@@ -32,8 +32,10 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.experiments.options import (
+    EPISODE_RECORD_BYTES,
     add_episode_options,
     add_resumable_run_options,
+    check_memory,
     cluster,
     count,
     episode_config,
@@ -161,6 +163,23 @@ def point_count(axes: list[Axis] | tuple[Axis, ...]) -> int:
     return math.prod(len(a.values) for a in axes)
 
 
+def check_axes(config: EpisodeConfig, axes, source: str = "GridSettings.axes") -> None:
+    """ParameterError naming `source` and the axis when an axis is given twice, or when its values, each set
+    alone in `config`, all walk the same episode (`EpisodeConfig.as_walked`): an axis that changes nothing."""
+    names = [field_name(a.name) for a in axes]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"{source}: axis {twice[0]} is given twice")
+    for axis, name in zip(axes, names):
+        if len(set(axis.values)) < 2:
+            continue
+        walked = [config.override({name: float(v)}).as_walked() for v in axis.values]
+        if all(w == walked[0] for w in walked):
+            raise ParameterError(f"{source}: axis {axis.name} ({min(axis.values):g} to {max(axis.values):g}) "
+                                 "changes nothing: every value walks the same episode (a window's time while "
+                                 "t2 <= t1, a level stretch on level ground?)")
+
+
 def check_size(axes: list[Axis] | tuple[Axis, ...], force: bool = False, source: str = "GridSettings.axes",
                insist: str = "force=True") -> None:
     """ParameterError naming `source`, the point count and MAX_GRID_POINTS when the grid is larger, unless
@@ -171,6 +190,7 @@ def check_size(axes: list[Axis] | tuple[Axis, ...], force: bool = False, source:
         raise ParameterError(f"{source}: the grid has {n:,} points ({sizes}), more than the limit of "
                              f"{MAX_GRID_POINTS:,} (each point is an episode, all held in memory before the "
                              f"first runs); give fewer points, or {insist} to run it anyway")
+    check_memory(f"{source}: {n:,} points", n * EPISODE_RECORD_BYTES, "give fewer points")
 
 
 def grid_points(axes: list[Axis]) -> list[dict[str, float]]:
@@ -317,6 +337,7 @@ class GridSettings:
 
     def __post_init__(self) -> None:
         check_size(self.axes, self.force)
+        check_axes(self.config, self.axes)
 
     def to_dict(self) -> dict[str, Any]:
         return {"config": self.config.to_dict(), "axes": [dataclasses.asdict(a) for a in self.axes]}
@@ -375,6 +396,7 @@ def settings_from_args(args: argparse.Namespace) -> GridSettings:
     axes = load_spec(args.spec) if args.spec is not None else table_iv_axes(args.points_per_axis or 2)
     source = f"--spec {args.spec}" if args.spec is not None else f"--points-per-axis {args.points_per_axis or 2}"
     check_size(axes, args.force, source, "--force")
+    check_axes(config, axes, source)
     return GridSettings(config, tuple(axes), force=args.force)
 
 

@@ -4,6 +4,7 @@ landscape.png, for the policy variances asked. Reads records only; simulates not
 from __future__ import annotations
 
 import argparse
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -11,6 +12,8 @@ from typing import Any
 from drake_biped.analysis.landscape import WindowRewards, landscape
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.options import (
+    check_memory,
+    check_size,
     count,
     number,
     out_folder,
@@ -24,6 +27,13 @@ from drake_biped.versions import versions
 
 __all__ = ["LandscapeSettings", "run", "summary_lines"]
 
+# Each sample is drawn at every policy mean of the landscape's grid (t1 0-0.8 s x t2 0-1 s by 0.025 s), and
+# held in memory while a mean is evaluated (about DRAW_BYTES each). MAX_DRAWS, over all variances, is about
+# three minutes on one core.
+LANDSCAPE_MEANS = 33 * 41
+DRAW_BYTES = 100
+MAX_DRAWS = 600_000
+
 
 @dataclass(frozen=True)
 class LandscapeSettings:
@@ -35,6 +45,19 @@ class LandscapeSettings:
     starts: tuple[tuple[float, float], ...] = ((0.5, 0.5),)
     samples: int = 2000
     seed: int = 0
+    force: bool = False  # draw more than MAX_DRAWS
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.samples, int) or isinstance(self.samples, bool) or self.samples < 1:
+            raise ParameterError(f"--samples {self.samples!r}: must be an integer >= 1")
+        if not self.variances or not all(math.isfinite(v) and v > 0 for v in self.variances):
+            raise ParameterError(f"--variance {list(self.variances)!r}: each must be a positive number")
+        if not all(len(s) == 2 and all(math.isfinite(x) and x >= 0 for x in s) for s in self.starts):
+            raise ParameterError(f"--start {list(self.starts)!r}: each start is two times >= 0 (s)")
+        check_memory(f"--samples {self.samples:,}", DRAW_BYTES * self.samples)
+        check_size(f"--samples {self.samples:,} x {len(self.variances)} variances",
+                   self.samples * len(self.variances), MAX_DRAWS,
+                   f"draws at each of the {LANDSCAPE_MEANS:,} policy means", self.force)
 
     def path(self) -> Path:
         source = Path(self.window_map)
@@ -89,6 +112,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="a policy start to evaluate (default 0.5 0.5)")
     p.add_argument("--samples", type=count, default=2000, help="Monte Carlo samples per mean")
     p.add_argument("--seed", type=seed_type, default=0, help="random seed")
+    p.add_argument("--force", action="store_true", help=f"draw more than {MAX_DRAWS:,} samples over all variances")
     p.add_argument("--out", default=None, type=out_folder, help="output folder (default: the window map's)")
 
 
@@ -96,7 +120,7 @@ def settings_from_args(args: argparse.Namespace) -> LandscapeSettings:
     """The landscape's settings from the command's options."""
     return LandscapeSettings(args.window_map, tuple(args.variance),
                              (tuple(args.start),) if args.start else ((0.5, 0.5),), samples=args.samples,
-                             seed=args.seed)
+                             seed=args.seed, force=args.force)
 
 
 def command(args: argparse.Namespace) -> int:

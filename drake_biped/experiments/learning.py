@@ -35,12 +35,14 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.long_run import measure_text
 from drake_biped.analysis.rewalks import measured_cost
 from drake_biped.analysis.reward import reward
 from drake_biped.experiments.learning_record import best_learned_trial, check_learning_record
 from drake_biped.experiments.options import (
     add_episode_options,
     add_resumable_run_options,
+    check_learning_size,
     cluster,
     count,
     episode_config,
@@ -192,11 +194,15 @@ class Trial:
 
 def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
                   mean=(0.5, 0.5), variance: float = 0.04, beta: float = 0.8, schedule=TABLE_II,
-                  learner: str = "garb", options: dict[str, Any] | None = None) -> dict[str, Any]:
-    if not isinstance(trials, int) or trials < 1:
+                  learner: str = "garb", options: dict[str, Any] | None = None, force: bool = False
+                  ) -> dict[str, Any]:
+    """The settings record of a learning run, checked (ParameterError naming the option), its size bounded
+    (`check_learning_size`) before any work."""
+    if not isinstance(trials, int) or isinstance(trials, bool) or trials < 1:
         raise ParameterError(f"--trials {trials!r}: must be an integer >= 1")
-    if not isinstance(episodes, int) or episodes < 1:
+    if not isinstance(episodes, int) or isinstance(episodes, bool) or episodes < 1:
         raise ParameterError(f"--episodes {episodes!r}: must be an integer >= 1")
+    check_learning_size(f"--trials {trials} x --episodes {episodes}", trials * episodes, force)
     if not isinstance(seed, int) or seed < 0:
         raise ParameterError(f"--seed {seed!r}: must be an integer >= 0")
     GarbLearner(mean, variance, beta, schedule)  # validates
@@ -343,8 +349,7 @@ def evaluate(settings: dict[str, Any], trials: list[Trial], client, rewalk_dista
     learned = [dict(_as_measured(t["walks"]["as_learned"]), trial=t["trial"], t1=t["t1"], t2=t["t2"])
                for t in rewalks["trials"]]
     walked = [measured_cost(r) for r in learned if not r["fell"] and measured_cost(r)]
-    measure = (f"long-run C_mt of {rewalks['distance_m']:g} m walks after the first 10 m"
-               if rewalks["distance_m"] >= REWALK_M else f"C_mt of {rewalks['distance_m']:g} m walks")
+    measure = measure_text(rewalks["distance_m"])
     out = {"measure": measure,
            "no_window": no_window, "learned": learned}
     if walked and measured_cost(no_window) and not no_window["fell"]:
@@ -406,12 +411,16 @@ class LearningSettings:
     schedule: tuple[tuple[int | None, float], ...] = TABLE_II
     learner: str = "garb"
     options: dict[str, Any] = field(default_factory=dict)
+    force: bool = False  # run more than MAX_EPISODES episodes
+
+    def __post_init__(self) -> None:
+        self.record()  # every value checked, the size bounded, before any work
 
     def record(self) -> dict[str, Any]:
         """The settings as every trial record and learning.json hold them (`make_settings`)."""
         return make_settings(self.config, self.trials, self.episodes, self.seed, mean=tuple(self.mean),
                              variance=self.variance, beta=self.beta, schedule=self.schedule,
-                             learner=self.learner, options=self.options)
+                             learner=self.learner, options=self.options, force=self.force)
 
 
 def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, progress: bool = True,
@@ -513,7 +522,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def settings_from_args(args: argparse.Namespace) -> LearningSettings:
     """The learning run's settings from the command's options."""
     return LearningSettings(episode_config(args), args.trials, args.episodes, args.seed if args.seed is not None else 0,
-                            mean=tuple(args.initial_mean), variance=args.variance, learner=args.learner)
+                            mean=tuple(args.initial_mean), variance=args.variance, learner=args.learner,
+                            force=args.force)
 
 
 def command(args: argparse.Namespace) -> int:

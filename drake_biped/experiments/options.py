@@ -7,12 +7,76 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
+import os
 import sys
 from contextlib import contextmanager
 from pathlib import Path
 
 from drake_biped.params import EpisodeConfig, ParameterError, with_time_step
 from drake_biped.resources import gait_names, load_gait
+
+# The sizes a run may be given, bounded before any work (`check_size`, `check_memory`). A run beyond a count
+# limit is refused unless forced (--force, force=True); one whose memory estimate exceeds half this machine's
+# memory is refused even then: it would be killed, leaving its folder locked.
+MAX_EPISODES = 100_000  # learning episodes of one run (trials x episodes, over every learner): ~8 h at 200/min
+MAX_WALKS = 2_000  # the walks of one analysis (stability cells, time-step study, ...)
+MAX_CANDIDATES = 2_000  # gait-search candidates (generations x offspring)
+EPISODE_RECORD_BYTES = 8_192  # what one episode's kept record holds in memory, at most (its touchdown rows)
+
+
+def check_size(what: str, count: int, limit: int, unit: str, force: bool = False, advice: str = "give fewer") -> None:
+    """ParameterError naming `what` (the options and values that set the size) when `count` `unit` exceed
+    `limit`, unless `force`: one line, before any work."""
+    if count > limit and not force:
+        raise ParameterError(f"{what}: {count:,} {unit}, more than the limit of {limit:,}; {advice}, or give "
+                             "--force (force=True) to run it anyway")
+
+
+def machine_memory_bytes() -> int:
+    """This machine's physical memory (bytes)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 8 << 30
+
+
+def check_memory(what: str, nbytes: float, advice: str = "give fewer") -> None:
+    """ParameterError naming `what` when its memory estimate `nbytes` exceeds half this machine's memory,
+    --force or not."""
+    limit = machine_memory_bytes() / 2
+    if nbytes > limit:
+        raise ParameterError(f"{what}: would hold about {nbytes / 2**30:,.1f} GiB in memory, more than half of "
+                             f"this machine's {2 * limit / 2**30:.0f} GiB; {advice}")
+
+
+def check_learning_size(what: str, episodes: int, force: bool = False) -> None:
+    """A learning run of `episodes` episodes in all, bounded before any work: MAX_EPISODES unless `force`, and
+    what its records hold in memory, always."""
+    check_size(what, episodes, MAX_EPISODES, "episodes", force)
+    check_memory(what, episodes * EPISODE_RECORD_BYTES)
+
+
+def check_walks(what: str, walks: int, force: bool = False, advice: str = "give fewer") -> None:
+    """An analysis of `walks` walks, bounded before any work: MAX_WALKS unless `force`, and what their records
+    hold in memory, always."""
+    check_size(what, walks, MAX_WALKS, "walks", force, advice)
+    check_memory(what, walks * EPISODE_RECORD_BYTES, advice)
+
+
+def check_reaches_touchdown(config: EpisodeConfig, touchdown: int, why: str) -> None:
+    """ParameterError naming --distance, before any walk, when `config`'s walks may end before touchdown
+    `touchdown` (counted from 0) whatever the gait: shorter than that many of the robot's longest steps
+    (`kinematics.longest_step_m`) and a leg. `why`: what needs that touchdown."""
+    from drake_biped.kinematics import leg_length_m, longest_step_m
+    from drake_biped.model import body_of_model
+
+    body = body_of_model(config.model)
+    step = longest_step_m(body)
+    need = (touchdown + 1) * step + leg_length_m(body)
+    if config.sim.distance_m < need:
+        raise ParameterError(f"--distance {config.sim.distance_m:g}: {why} needs touchdown {touchdown}, which a walk "
+                             f"shorter than {need:.1f} m may not reach (a step of this robot is at most {step:.2f} m); "
+                             f"walk at least {math.ceil(need):g} m")
 
 
 def number(kind: str):
@@ -159,6 +223,9 @@ def episode_config(args: argparse.Namespace) -> EpisodeConfig:
     if args.level_length is not None:
         changes["ground.level_length_m"] = args.level_length
     config = with_clock(config.override(changes), args.time_step, args.control_period)
+    if args.level_length is not None and config.ground.slope_rad == 0.0:
+        raise ParameterError(f"--level-length {args.level_length:g}: the ground is level (no --slope), so a level "
+                             "stretch before it changes nothing; give --slope too")
     config = with_model(config, args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
         print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
@@ -190,8 +257,17 @@ def policy_window(path: Path) -> tuple[float, float]:
     return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
 
 
-def chosen_window(args: argparse.Namespace) -> tuple[float, float]:
-    """The torque-free period to compare against none: --policy, or --t1/--t2, or 0.2-0.5 s."""
+def default_window(config: EpisodeConfig) -> tuple[float, float]:
+    """The window a command compares with none when none is given: the gait's own where it carries one, else
+    the default gait's learned window (params.LEARNED_WINDOW_S)."""
+    from drake_biped.params import LEARNED_WINDOW_S
+
+    w = config.window
+    return (w.start_s, w.end_s) if w.active else LEARNED_WINDOW_S
+
+
+def chosen_window(args: argparse.Namespace, config: EpisodeConfig | None = None) -> tuple[float, float]:
+    """The torque-free period to compare against none: --policy, or --t1/--t2, or `default_window(config)`."""
     if args.policy is not None and args.t1 is not None:
         raise ParameterError("give either --policy or --t1/--t2, not both")
     if (args.t1 is None) != (args.t2 is None):
@@ -202,7 +278,7 @@ def chosen_window(args: argparse.Namespace) -> tuple[float, float]:
         if args.t2 <= args.t1:
             raise ParameterError(f"--t1 {args.t1} --t2 {args.t2}: need t1 < t2")
         return args.t1, args.t2
-    return 0.2, 0.5
+    return default_window(config if config is not None else EpisodeConfig())
 
 
 def steps(text: str) -> list[float]:
@@ -247,8 +323,9 @@ def positive_list(text: str) -> list[float]:
 
 
 def add_window_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default 0.2")
-    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); default 0.5")
+    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default: the gait's own window, "
+                   "else the default gait's learned one (0.3672-0.8629 s)")
+    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); given with --t1")
     p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
                    "(the trial with a window and the lowest C_mt)")
 

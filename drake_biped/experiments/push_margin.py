@@ -33,7 +33,14 @@ from drake_biped.experiments.options import (
 )
 from drake_biped.experiments.stability import CONDITIONS, condition_window
 from drake_biped.paper import PUSH_DURATION_S
-from drake_biped.params import EpisodeConfig, ParameterError, Push, check_settings, walked_the_distance
+from drake_biped.params import (
+    LEARNED_WINDOW_S,
+    EpisodeConfig,
+    ParameterError,
+    Push,
+    check_settings,
+    walked_the_distance,
+)
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
@@ -48,7 +55,7 @@ class PushMarginSettings:
     """The gait, the torque-free period compared with none, the force grid, the phases and the timing."""
 
     config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 12.0}))
-    window: tuple[float, float] = (0.2, 0.5)
+    window: tuple[float, float] = LEARNED_WINDOW_S
     max_force_n: float = 100.0
     force_step_n: float = 5.0
     phases: int = 12
@@ -267,7 +274,7 @@ def settings_from_args(args: argparse.Namespace) -> PushMarginSettings:
     config = episode_config(args)
     if args.distance is None:  # a push at --settle s (about 6 m), then room to recover or fall
         config = config.override({"sim.distance_m": 12.0, "sim.max_time_s": max(config.sim.max_time_s, 72.0)})
-    return PushMarginSettings(config, chosen_window(args), max_force_n=args.max_force, force_step_n=args.force_step,
+    return PushMarginSettings(config, chosen_window(args, config), max_force_n=args.max_force, force_step_n=args.force_step,
                               phases=args.phases, settle_s=args.settle, force=args.force)
 
 

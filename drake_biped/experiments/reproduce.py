@@ -45,6 +45,7 @@ from drake_biped.experiments.options import (
 )
 from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import (
+    LEARNED_WINDOW_S,
     PAPER_CPG,
     EpisodeConfig,
     Ground,
@@ -60,7 +61,7 @@ from drake_biped.versions import versions
 
 __all__ = ["FULL", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run", "steps_of"]
 
-LEVEL_WINDOW = (0.2, 0.5)  # the window compared with none where no window was learned and none of the map walks
+LEVEL_WINDOW = LEARNED_WINDOW_S  # compared with none where no window was learned and none of the map walks
 SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
 # The 2.0 deg grid's changes to the default gait: Table VII's CPG parameters raised (the paper: +25 to +51 %)
 # and the torso leaned further forward (rad), with a larger placement gain.

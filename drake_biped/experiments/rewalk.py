@@ -87,7 +87,8 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
     for change in CHANGES:
         for t in learned:
             rows[change].setdefault(t["trial"], rows[change]["no_window"])
-    return {**summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows), "distance_m": distance_m}
+    return {**summary(config.sim.time_step_s, config.initial.speed_mps, learned, rows), "distance_m": distance_m,
+            "controller_clock": config.sim.clock, "update_period_s": config.sim.update_period_s}
 
 
 def rewalk_record(source: Path, client) -> dict[str, Any]:

@@ -41,6 +41,7 @@ from drake_biped.experiments.options import (
     add_episode_options,
     add_resumable_run_options,
     add_window_options,
+    check_learning_size,
     chosen_window,
     cluster,
     count,
@@ -51,6 +52,7 @@ from drake_biped.experiments.rewalk import changed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
 from drake_biped.params import (
+    LEARNED_WINDOW_S,
     EpisodeConfig,
     Ground,
     ParameterError,
@@ -288,12 +290,20 @@ class SlopeSettings:
     slope_rad: float = SLOPE_RAD
     level_length_m: float = SLOPE_LEVEL_LENGTH_M
     policy: str | None = None
-    window: tuple[float, float] = (0.2, 0.5)
+    window: tuple[float, float] = LEARNED_WINDOW_S
     variance: float = GARB_VARIANCE_S2
     trials: int = 2
     episodes: int = 100
     seed: int = 0
     gait: str | None = None
+    force: bool = False  # run more than MAX_EPISODES episodes
+
+    def __post_init__(self) -> None:
+        for name, value in (("--trials", self.trials), ("--episodes", self.episodes)):
+            if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+                raise ParameterError(f"{name} {value!r}: must be an integer >= 1")
+        check_learning_size(f"--trials {self.trials} x --episodes {self.episodes}", self.trials * self.episodes,
+                            self.force)
 
     def ground(self) -> Ground:
         return slope_ground(self.slope_rad, self.level_length_m, self.config.ground.friction)
@@ -361,11 +371,11 @@ def settings_from_args(args: argparse.Namespace) -> SlopeSettings:
         if args.t1 is not None or args.t2 is not None:
             raise ParameterError("give either --policy or --t1/--t2, not both")
         settings = SlopeSettings(config, slope_rad, level, policy=str(args.policy), trials=args.trials,
-                                       episodes=args.episodes, seed=config.seed)
+                                       episodes=args.episodes, seed=config.seed, force=args.force)
     else:
-        settings = SlopeSettings(config, slope_rad, level, window=chosen_window(args),
+        settings = SlopeSettings(config, slope_rad, level, window=chosen_window(args, config),
                                        variance=args.variance, trials=args.trials, episodes=args.episodes,
-                                       seed=config.seed)
+                                       seed=config.seed, force=args.force)
     settings.start()
     return settings
 

@@ -30,6 +30,9 @@ from drake_biped.experiments.options import (
     add_episode_options,
     add_resumable_run_options,
     add_window_options,
+    check_reaches_touchdown,
+    check_size,
+    check_walks,
     chosen_window,
     cluster,
     count,
@@ -38,6 +41,7 @@ from drake_biped.experiments.options import (
 )
 from drake_biped.paper import TABLE_VI
 from drake_biped.params import (
+    LEARNED_WINDOW_S,
     EpisodeConfig,
     InitialConditions,
     ParameterError,
@@ -53,14 +57,16 @@ DISTURBANCES = ("undisturbed", "forward", "backward")
 TABLE_VI_PAPER = TABLE_VI  # eigenvalues of the return map, as (real, imaginary) pairs
 
 
-JACOBIAN_KICKS_RAD = (0.005, 0.01, 0.02)  # swing-hip angle kicks; rate kicks are 10x (rad/s)
+JACOBIAN_KICKS_RAD = (0.005, 0.01, 0.02)
+JACOBIAN_STEP = 8  # the touchdown before which the Jacobian's kicks act (the map is to the next)
+MAX_BOOTSTRAP = 100_000  # bootstrap resamples of the return maps' eigenvalues  # swing-hip angle kicks; rate kicks are 10x (rad/s)
 
 
 @dataclass(frozen=True)
 class StabilitySettings:
     """What a stability run depends on besides the episode configuration."""
 
-    window: tuple[float, float] = (0.2, 0.5)
+    window: tuple[float, float] = LEARNED_WINDOW_S
     trials: int = 8
     push_force_n: float = 20.0
     push_start_s: float = 0.4
@@ -75,6 +81,7 @@ class StabilitySettings:
     config: EpisodeConfig | None = None
     jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD
     floquet: bool = False
+    force: bool = False  # run more than MAX_WALKS walks
 
     def __post_init__(self) -> None:
         t1, t2 = self.window
@@ -91,10 +98,24 @@ class StabilitySettings:
             raise ParameterError(f"spread {self.spread!r}: must be in [0, 0.5)")
         if not isinstance(self.steady_from_step, int) or self.steady_from_step < 1:
             raise ParameterError(f"steady_from_step {self.steady_from_step!r}: must be an integer >= 1")
+        if not isinstance(self.bootstrap, int) or isinstance(self.bootstrap, bool) or self.bootstrap < 0:
+            raise ParameterError(f"bootstrap {self.bootstrap!r}: must be an integer >= 0")
+        check_walks(f"--trials {self.trials}", len(CONDITIONS) * len(DISTURBANCES) * self.trials, self.force)
+
+    def check_walks_reach(self) -> None:
+        """ParameterError naming --distance, before any walk, when the gait's walks may end before the
+        touchdowns the analysis needs (`options.check_reaches_touchdown`)."""
+        config = self.config if self.config is not None else EpisodeConfig()
+        check_reaches_touchdown(config, self.steady_from_step, "the return map's equilibrium (the undisturbed "
+                                f"sections from step {self.steady_from_step} on)")
+        if self.jacobian_kicks:
+            check_reaches_touchdown(config, JACOBIAN_STEP + 1, f"the finite-difference Jacobian (kicked before "
+                                    f"touchdown {JACOBIAN_STEP})")
+        check_size(f"bootstrap {self.bootstrap}", self.bootstrap, MAX_BOOTSTRAP, "resamples", self.force)
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
-        for name in ("config", "jacobian_kicks", "floquet"):
+        for name in ("config", "jacobian_kicks", "floquet", "force"):
             d.pop(name)
         d["window"] = list(self.window)
         return d
@@ -246,7 +267,7 @@ def _section(result: dict[str, Any], index: int) -> np.ndarray | None:
     return None
 
 
-def finite_difference_jacobian(base: EpisodeConfig, client, step: int = 8, angle_rad: float = 0.005,
+def finite_difference_jacobian(base: EpisodeConfig, client, step: int = JACOBIAN_STEP, angle_rad: float = 0.005,
                                rate_radps: float = 0.05, lead_s: float = 0.03, kicks: int = 16,
                                seed: int = 0) -> dict[str, Any]:
     """The step-to-step Jacobian of the gait at touchdown `step`, by finite differences in Drake.
@@ -325,6 +346,7 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     without and with the window (experiments/floquet.py; floquet_without/, floquet_with/ and a report
     section). The record."""
     check_settings(settings, StabilitySettings, "stability.run")
+    settings.check_walks_reach()
     from drake_biped.analysis.stability_report import write_stability_outputs
     from drake_biped.experiments.executor import client_or_local
     from drake_biped.experiments.progress import progress_bar
@@ -381,8 +403,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def settings_from_args(args: argparse.Namespace) -> StabilitySettings:
     """The stability study's settings from the command's options."""
     config = episode_config(args)
-    return StabilitySettings(window=chosen_window(args), trials=args.trials, push_force_n=args.push,
-                             spread=args.spread, seed=config.seed, config=config, floquet=args.floquet)
+    settings = StabilitySettings(window=chosen_window(args, config), trials=args.trials, push_force_n=args.push,
+                                 spread=args.spread, seed=config.seed, config=config, floquet=args.floquet,
+                                 force=args.force)
+    settings.check_walks_reach()
+    return settings
 
 
 def command(args: argparse.Namespace) -> int:

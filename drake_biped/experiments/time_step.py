@@ -24,13 +24,14 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
+from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, has_long_run, long_run_of_record
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
 from drake_biped.experiments.options import (
     add_clock_option,
     add_cluster_options,
     add_model_option,
+    check_walks,
     cluster,
     number,
     out_folder,
@@ -41,6 +42,7 @@ from drake_biped.experiments.options import (
 )
 from drake_biped.params import (
     GRAVITY_MPS2,
+    LEARNED_WINDOW_S,
     EpisodeConfig,
     ParameterError,
     SimulationParams,
@@ -55,7 +57,7 @@ from drake_biped.versions import versions
 
 # The default gait's learned window (the committed full run's Experiment 1: its best trial, trial 1, rounded as
 # the reproduction rounds it) and a window early in the swing.
-WALKS = [None, (0.3672, 0.8629), (0.3, 0.6)]
+WALKS = [None, LEARNED_WINDOW_S, (0.3, 0.6)]
 TOLERANCE = 0.01
 LONG_WALK_M = TRANSIENT_M + LONG_RUN_M
 STEPS = (0.002, 0.001, 0.0005, 0.00025, 0.000125)
@@ -118,7 +120,7 @@ def richardson(rows: list[dict], steps: list[float], window) -> dict:
     by = {r["time_step_s"]: r for r in rows if tuple(r["window"] or ()) == tuple(window or ())}
     fine = sorted(steps)[:3]
     out = {"order": None, "order_observed": False, "limit": None, "errors": {}}
-    if len(fine) < 3 or any(abs(fine[i + 1] / fine[i] - 2.0) > 1e-9 for i in range(2)):
+    if not _halving(steps):
         return out
     values = [by[h]["cost_of_transport"] if by[h]["walked"] else None for h in fine]
     if any(v is None for v in values):
@@ -138,6 +140,12 @@ def richardson(rows: list[dict], steps: list[float], window) -> dict:
                errors={f"{h:g}": (by[h]["cost_of_transport"] / limit - 1.0
                                   if by[h]["walked"] and by[h]["cost_of_transport"] else None) for h in steps})
     return out
+
+
+def _halving(steps: list[float]) -> bool:
+    """Whether the three finest steps halve (Richardson's estimate needs them)."""
+    fine = sorted(steps)[:3]
+    return len(fine) == 3 and all(abs(fine[i + 1] / fine[i] - 2.0) <= 1e-9 for i in range(2))
 
 
 def _walks_of(rec: dict) -> list:
@@ -251,10 +259,11 @@ def markdown(rec: dict) -> str:
         "",
         "## Richardson's estimate from the three finest steps",
         "",
-        "Noise-dominated: a difference between two of the three finest steps lies within its 95 % interval, so "
-        "the estimate extrapolates the walks' scatter, not the discretisation.",
-        "",
-        *rich_lines,
+        *(["Noise-dominated: a difference between two of the three finest steps lies within its 95 % interval, "
+           "so the estimate extrapolates the walks' scatter, not the discretisation.", "", *rich_lines]
+          if _halving(steps) else
+          ["Not computed: it needs three finest steps that halve (h, h/2, h/4); the study has "
+           + ", ".join(f"{h * 1e3:g} ms" for h in sorted(steps)) + "."]),
         "",
         "## The episode's C_mt (whole walk, initiation included)",
         "",
@@ -322,6 +331,7 @@ class TimeStepSettings:
     config: EpisodeConfig | None = None
     gait: str = "Default gait"
     windows: tuple[tuple[float, float], ...] | None = None
+    force: bool = False  # more than MAX_WALKS walks
 
     def __post_init__(self) -> None:
         sim = (self.config or EpisodeConfig()).sim
@@ -332,6 +342,14 @@ class TimeStepSettings:
         for t1, t2 in self.windows or ():
             if not 0.0 <= t1 < t2:
                 raise ParameterError(f"--windows {t1:g}-{t2:g}: need 0 <= t1 < t2")
+        if not has_long_run(self.distance_m):
+            raise ParameterError(f"--distance {self.distance_m:g}: the study compares long-run means, which need "
+                                 f"walks of at least {TRANSIENT_M + LONG_RUN_M:g} m (the first {TRANSIENT_M:g} m "
+                                 f"dropped, {LONG_RUN_M:g} m measured)")
+        if len(set(self.steps)) != len(self.steps):
+            raise ParameterError(f"--steps {','.join(f'{h:g}' for h in self.steps)}: a step is given twice")
+        check_walks(f"--steps ({len(self.steps)}) x walks ({1 + len(self.windows or WALKS[1:])})",
+                    len(self.steps) * (1 + len(self.windows or WALKS[1:])), self.force)
 
 
 def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = True) -> dict:
@@ -409,7 +427,7 @@ def settings_from_args(args: argparse.Namespace) -> TimeStepSettings:
     reference = min(chosen) if args.reference is None else args.reference
     return TimeStepSettings(tuple(chosen), reference, args.distance, config,
                             "Default gait" if args.params is None else f"Gait {args.params}",
-                            None if args.windows is None else tuple(args.windows))
+                            None if args.windows is None else tuple(args.windows), force=args.force)
 
 
 def command(args: argparse.Namespace) -> int:
