@@ -20,24 +20,43 @@ from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
 from drake_biped.records import save_figure, write_text_atomic
 
+SLOPE_LEVEL_M = 2.0  # the level ground before the dynamics step's slopes (Reproduction.dynamics)
 REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
     "reproduced", "partly reproduced", "not reproduced", "differs", "beyond the paper")
 
 
 
-def _n(force) -> str:
-    """A margin in N, or — where none was measured."""
-    return "—" if force is None else f"{force:.0f}"
+def _margin(margins: dict, condition: str, direction: str) -> str:
+    """One margin of a push-margin summary (`Reproduction.push_margin`) in N."""
+    m = margins[condition]
+    return _n(m[direction], m.get(f"{direction}_at_grid_top", False))
 
 
-def _margin_method(settings: dict) -> str:
-    """How a push-margin step measured its margins, from its settings."""
+def _n(force, at_top: bool = False) -> str:
+    """A margin in N, "≥ N" where every force tried survived, or — where none was measured."""
+    return "—" if force is None else ("≥ " if at_top else "") + f"{force:.0f}"
+
+
+# What a push-margin step recorded before its summary held its method: PushMarginSettings' values then.
+_MARGIN_METHOD_BEFORE = {"phases": 12, "settle_s": 5.0, "max_force_n": 100.0, "push_duration_s": 0.1}
+
+
+def _margin_method(settings: dict, method: dict | None = None) -> str:
+    """How a push-margin step measured its margins, from its settings and the method its summary records."""
     if "force_step_n" in settings:
-        return (f"Pushes of 0.1 s in steady state (12 phases of the first step after 5 s of a "
-                f"{settings['distance_m']:g} m walk) on a grid {settings['force_step_n']:g} N apart up to 100 N; the "
-                "margin is the largest force at and below which every phase survives (the paper pushes ±20 N):")
+        m = method or _MARGIN_METHOD_BEFORE
+        return (f"Pushes of {m['push_duration_s']:g} s in steady state ({m['phases']} phases of the first step after "
+                f"{m['settle_s']:g} s of a {settings['distance_m']:g} m walk) on a grid {settings['force_step_n']:g} N "
+                f"apart up to {m['max_force_n']:g} N; the margin is the largest force at and below which every phase "
+                "survives (the paper pushes ±20 N); a margin at the grid's top is a bound (≥):")
     return (f"The largest push over 0.1 s from 0.4 s after which the gait still walks {settings['distance_m']:g} m, "
             f"by bisection to {settings['tolerance_n']:g} N from 200 N (the paper pushes ±20 N):")
+
+def _start_text(settings: dict) -> str:
+    """A learning run's start, from its settings record: "start 0.5, 0.5 s; σ² 0.04"."""
+    learner = settings["learner"]
+    return f"start {learner['mean'][0]:g}, {learner['mean'][1]:g} s; σ² {learner['variance']:g}"
+
 
 def _pct(x: float | None) -> str:
     if x is None:
@@ -203,18 +222,32 @@ def attractor_text(point: dict[str, Any]) -> str:
     return text
 
 
+def _bound(premise: dict[str, Any], key: str) -> str:
+    """A slope envelope of `bifurcation.premise`: "0.015", or "≥ 0.06" where it is the sweep's last slope."""
+    value = premise[key]
+    if value is None:
+        return "none"
+    return ("≥ " if premise.get(f"{key}_is_bound") else "") + f"{value:g}"
+
+
+def _dynamics_walks_m(d: dict[str, Any]) -> tuple[float, float, float, float]:
+    """The dynamics step's walk lengths (m): the attractors, the sweeps, the slopes (2 m level included), the
+    basins (Profile.dynamics_walks_m, recorded in its settings)."""
+    return tuple(d["settings"]["walks_m"])
+
+
 def dynamics_rows(d: dict[str, Any], wtext: str) -> list[tuple[str, str, str, str]]:
     """The dynamics step's verdict rows: the attractors, the slope premise, the Table III walker."""
     none, learned = d["learned"]
-    rows = [("What the walk settles on (110 m)", "—",
+    long_m, _, slope_m, _ = _dynamics_walks_m(d)
+    rows = [(f"What the walk settles on ({long_m:g} m)", "—",
              f"no window: {attractor_text(none)}; {wtext}: {attractor_text(learned)}", BEYOND)]
     pr = d["premise"]
-    up = {k: "none" if v is None else f"{v:g} rad" for k, v in (("without", pr["without_up_to"]),
-                                                                ("with", pr["with_up_to"]))}
+    up = {k: "none" if pr[f"{k}_up_to"] is None else _bound(pr, f"{k}_up_to") + " rad" for k in ("without", "with")}
     band = (f"the window fails and none climbs at {', '.join(f'{v:g}' for v in pr['band'])} rad" if pr["band"]
             else "no slope where the window fails and none climbs")
     rows.append(("The slope premise: the learned window cannot climb where none can", "holds at 0.02 rad",
-                 f"climbs 30 m up to: none {up['without']}, {wtext} {up['with']}; {band}",
+                 f"climbs {slope_m - SLOPE_LEVEL_M:g} m up to: none {up['without']}, {wtext} {up['with']}; {band}",
                  REPRODUCED if pr["holds"] else NOT_REPRODUCED))
     rows.append(("Table III, entrained reading (`paper_entrained`): a gait?", "walks",
                  "; ".join(f"{1e3 * p['time_step_s']:g} ms: {attractor_text(p)}" for p in d["paper_entrained"]),
@@ -225,13 +258,15 @@ def dynamics_rows(d: dict[str, Any], wtext: str) -> list[tuple[str, str, str, st
 def dynamics_section(out: Path, d: dict[str, Any], wtext: str) -> list[str]:
     """The gait as a dynamical system: the bifurcation over t1, the slope envelopes, the basins."""
     pr = d["premise"]
+    slope_m = _dynamics_walks_m(d)[2]
     return [
         "## The gait as a dynamical system (`dynamics/`, beyond the paper)",
         "",
-        "Each walk is read by its step periods after the first 10 m: period-k where every k-th period varies by "
-        "less than 2 ms, read again at 10 ms (the 1 kHz controller sees a touchdown only at its next update, so "
-        "even a regular gait's periods jitter by a few ms), irregular ones with a finite-size Lyapunov exponent "
-        "from a neighbour walk (`drake-biped bifurcation`, `drake-biped basins`).",
+        "Each walk is read by its step periods after the transient its sweep names: period-k where every k-th "
+        "period varies by less than 2 ms, read again at 10 ms (a controller that updates on a grid sees a "
+        "touchdown only at its next update, so even a regular gait's periods jitter by up to its update period), "
+        "irregular ones with a finite-size Lyapunov exponent from a neighbour walk (`drake-biped bifurcation`, "
+        "`drake-biped basins`).",
         "",
         "### Bifurcation over t1, the learned t2 kept (`dynamics/t1/`)",
         "",
@@ -240,8 +275,9 @@ def dynamics_section(out: Path, d: dict[str, Any], wtext: str) -> list[str]:
         "",
         "### The slope premise (`dynamics/slope_without/`, `dynamics/slope_with/`)",
         "",
-        f"The steepest slope climbed for 30 m after 2 m level (every slope up to it climbed): without a window "
-        f"**{pr['without_up_to']}** rad, with {wtext} **{pr['with_up_to']}** rad. Slopes where the window falls "
+        f"The steepest slope climbed for {slope_m - SLOPE_LEVEL_M:g} m after {SLOPE_LEVEL_M:g} m level (every slope "
+        "up to it climbed; the last slope of the sweep is a bound, ≥): without a window "
+        f"**{_bound(pr, 'without_up_to')}** rad, with {wtext} **{_bound(pr, 'with_up_to')}** rad. Slopes where the window falls "
         f"and no window climbs: {', '.join(f'{v:g}' for v in pr['band']) or 'none'}. The paper's slope story "
         "needs such a band; its 0.02 rad is run as printed in the slope stories below.",
         "",
@@ -286,7 +322,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                      REPRODUCED if not pg["fell"] else NOT_REPRODUCED))
     best = grid["best"]
     verdicts.append(("Table IV grid: furthest walk", "Table III, walks",
-                     f"{best['distance_m']:.2f} m of {grid['points']} points ({grid['walked']} walk 10 m)", DIFFERS))
+                     f"{best['distance_m']:.2f} m of {grid['points']} points ({grid['walked']} walk "
+                     f"{profile.distance_m:g} m)", DIFFERS))
     learn_ours, learn_verdict = reduction_verdict(s["learn"]["evaluation"])
     verdicts.append(("Table V: C_mt reduction by learning (paper's settings)", "−50 % (0.58 → 0.29)",
                      learn_ours, learn_verdict))
@@ -301,9 +338,9 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append((f"Table VI: stable under ±20 N, none vs the learned window ({wtext})", "all stable", stab_ours,
                      stab_verdict))
     m = s["push_margin"]["margins"]
-    verdicts.append(("Push margins (forward / backward)", "survives ±20 N", f"none {_n(m['without']['forward'])} / "
-                     f"{_n(m['without']['backward'])} N, {wtext} {_n(m['with']['forward'])} / "
-                     f"{_n(m['with']['backward'])} N", BEYOND))
+    verdicts.append(("Push margins (forward / backward)", "survives ±20 N", f"none {_margin(m, 'without', 'forward')} / "
+                     f"{_margin(m, 'without', 'backward')} N, {wtext} {_margin(m, 'with', 'forward')} / "
+                     f"{_margin(m, 'with', 'backward')} N", BEYOND))
     verdicts.append(("Full-state Floquet multipliers (periodic orbit, through Drake)", "—",
                      floquet_text(s["floquet"]["gaits"]), BEYOND))
     if "dynamics" in s:
@@ -348,7 +385,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "## Grid search, Table IV (`grid/`)",
         "",
         f"{grid['points']} points over Table IV's CPG ranges and the initiation, level ground, one episode each: "
-        f"{grid['walked']} walk 10 m; the furthest, {best['distance_m']:.2f} m, at "
+        f"{grid['walked']} walk {profile.distance_m:g} m; the furthest, {best['distance_m']:.2f} m, at "
         + ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in best["point"].items())
         + f". Table III itself (with the default gait's other gains) falls after {_steps(t3['steps'])} "
         f"({t3['distance_m']:.2f} m). The default gait's CPG: "
@@ -363,7 +400,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"The shipped gait `paper`: Table III's CPG ({', '.join(f'{k} {v:g}' for k, v in pg['cpg'].items())}) and the "
         f"paper's initiation, ζ driving the swing unscaled (the integrated reading), the gains the paper does not "
         f"print from a search of 1 430 candidates (docs/HISTORY.md): "
-        + ("walks 10 m" if not pg["fell"] else f"falls after {_steps(pg['steps'])} ({pg['fall_reason']}), "
+        + (f"walks {pg['distance_m']:.2f} m" if not pg["fell"] else f"falls after {_steps(pg['steps'])} ({pg['fall_reason']}), "
                                               f"{pg['distance_m']:.2f} m")
         + ". Record: [result.json](paper_gait/result.json).",
         "",
@@ -373,7 +410,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     lines += [
         "## Torque-free windows of the default gait (`window_map/`)",
         "",
-        f"{wm['walked']} of {wm['windows']} windows walk 10 m; no window C_mt "
+        f"{wm['walked']} of {wm['windows']} windows walk {profile.distance_m:g} m; no window C_mt "
         f"{_num(wm['no_window_cost_of_transport'])}"
         + ("" if wbest is None else f"; the cheapest, {wbest['t1']:g}–{wbest['t2']:g} s, C_mt "
            f"{_num(wbest['cost_of_transport'])} ({_pct(wbest['cmt_change'])})") + ".",
@@ -383,7 +420,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "## Experiment 1: learning the torque-free period (Table V, Figs. 4–6; `learn/`)",
         "",
         f"Verdict: **{learn_verdict}**. {s['learn']['settings']['trials']} trials × "
-        f"{s['learn']['settings']['episodes']} episodes, the paper's settings (start 0.5, 0.5 s; σ² 0.04; "
+        f"{s['learn']['settings']['episodes']} episodes, the paper's settings ({_start_text(s['learn']['settings'])}; "
         f"Table II); {_num(s['learn']['episodes_per_min'], 1)} episodes/min. Each trial's final policy mean is "
         "re-walked with the plant step halved and from 0.95 and 1.05 × the initiation speed, each against no "
         "window under the same change.",
@@ -395,7 +432,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         "### Exploration matched to the gait (`learn_variant/`)",
         "",
-        f"Verdict: **{var_verdict}**. Start (0.4, 0.4) s, σ² 0.01, narrower than the paper's σ = 0.2 s.",
+        f"Verdict: **{var_verdict}**. {_start_text(s['learn_variant']['settings']).capitalize()}, where the "
+        "paper's is 0.5, 0.5 s with σ² 0.04 (σ = 0.2 s).",
         "",
         embed(_read(out, "learn_variant/table_v.md"), "learn_variant"),
         "![Fig. 6, variant](learn_variant/fig6_times.png)",
@@ -407,12 +445,12 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         embed(_read(out, "stability/report.md"), "stability"),
         "### Push margins (`push_margin/`)",
         "",
-        _margin_method(s["push_margin"]["settings"]),
+        _margin_method(s["push_margin"]["settings"], s["push_margin"].get("method")),
         "",
         "| | forward (N) | backward (N) |",
         "|---|---|---|",
-        f"| no torque-free period | {_n(m['without']['forward'])} | {_n(m['without']['backward'])} |",
-        f"| the learned window, {wtext} | {_n(m['with']['forward'])} | {_n(m['with']['backward'])} |",
+        f"| no torque-free period | {_margin(m, 'without', 'forward')} | {_margin(m, 'without', 'backward')} |",
+        f"| the learned window, {wtext} | {_margin(m, 'with', 'forward')} | {_margin(m, 'with', 'backward')} |",
         "",
         "### The periodic orbit and its Floquet multipliers (`floquet/`)",
         "",

@@ -175,7 +175,10 @@ def premise(without: list[dict[str, Any]], with_window: list[dict[str, Any]]) ->
     if [p["value"] for p in without] != [p["value"] for p in with_window]:
         raise ValueError("premise: the two sweeps must cover the same values")
     band = [a["value"] for a, b in zip(without, with_window) if b["fell"] and not a["fell"]]
-    return {"without_up_to": walked_up_to(without), "with_up_to": walked_up_to(with_window), "band": band,
+    last = without[-1]["value"] if without else None
+    up = {"without_up_to": walked_up_to(without), "with_up_to": walked_up_to(with_window)}
+    # an envelope at the sweep's last value is a bound: steeper slopes were not tried
+    return {**up, **{f"{k}_is_bound": v is not None and v == last for k, v in up.items()}, "band": band,
             "holds": bool(band)}
 
 
@@ -263,8 +266,14 @@ def markdown(record: dict[str, Any]) -> str:
         lines.append(f"| {p['value']:g} | {1e3 * p['time_step_s']:g} | {p['attractor']} | "
                      f"{p['within_jitter']['attractor']} | {span} | {exponent} | {cmt} |")
     up_to = record.get("walked_up_to")
-    lines += ["", f"Every walk from {record['param']} = {record['values'][0]:g} walks up to "
-              + ("none: the first falls." if up_to is None else f"{up_to:g}.")]
+    values = record["values"]
+    if up_to is None:
+        envelope = "none: the first falls."
+    elif up_to == values[-1] and len(values) > 1:
+        envelope = f"the sweep's end, {up_to:g}: every value walks, so the envelope is ≥ {up_to:g} (not reached)."
+    else:
+        envelope = f"{up_to:g}."
+    lines += ["", f"Every walk from {record['param']} = {values[0]:g} walks up to " + envelope]
     return "\n".join(lines) + "\n"
 
 

@@ -44,7 +44,7 @@ from drake_biped.params import (
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["PushMarginSettings", "margin_of", "markdown", "push_margin", "run"]
+__all__ = ["PushMarginSettings", "margin_of", "margin_text", "markdown", "push_margin", "run"]
 
 # At most this many pushed walks without --force.
 MAX_EPISODES = 5000
@@ -97,6 +97,13 @@ def steady_step(result: dict[str, Any], settle_s: float) -> tuple[float, float] 
         if a >= settle_s:
             return a, b
     return None
+
+
+def margin_text(cell: dict[str, Any]) -> str:
+    """A direction's margin as a report gives it: "35", or "≥ 100" where every force tried survives."""
+    if cell.get("margin_n") is None:
+        return "—"
+    return ("≥ " if cell.get("at_grid_top") else "") + f"{cell['margin_n']:g}"
 
 
 def margin_of(forces: list[float], survived: list[list[bool]]) -> float:
@@ -155,6 +162,8 @@ def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, i
             cell = m[direction]
             if m["step_s"] is not None:
                 cell["margin_n"] = margin_of(forces, cell["survived"])
+                # every force tried survived: the margin is a lower bound, not where the walker fails
+                cell["at_grid_top"] = bool(forces) and cell["margin_n"] == forces[-1]
                 cell["impulse_ns"] = cell["margin_n"] * settings.push_duration_s
                 cell["phases_s"] = [m["step_s"][0] + (j / phases) * (m["step_s"][1] - m["step_s"][0])
                                     for j in range(phases)]
@@ -173,12 +182,13 @@ def markdown(record: dict[str, Any]) -> str:
             lines.append(f"| {names[condition]} | — | — | the unpushed walk "
                          f"{'has no step after the settling time' if m['unpushed_walks'] else 'falls'} |")
             continue
-        lines.append(f"| {names[condition]} | {m['forward']['margin_n']:g} | {m['backward']['margin_n']:g} | "
+        lines.append(f"| {names[condition]} | {margin_text(m['forward'])} | {margin_text(m['backward'])} | "
                      f"{m['step_s'][0]:.3f}–{m['step_s'][1]:.3f} |")
     lines += ["", f"Each force from {record['force_step_n']:g} N to {record['max_force_n']:g} N in steps of "
               f"{record['force_step_n']:g} N, for {record['push_duration_s']:g} s, at {record['phases']} phases of the "
               f"first step after {record['settle_s']:g} s; survived: the walk still walks its "
-              f"{record['distance_m']:g} m. The margin: the largest force at and below which every phase survives.",
+              f"{record['distance_m']:g} m. The margin: the largest force at and below which every phase survives "
+              "(≥: every force tried survives, so the margin is not reached).",
               ""]
     for condition in CONDITIONS:
         m = record["margins"][condition]

@@ -385,7 +385,8 @@ class Reproduction:
         def run(folder: Path) -> dict:
             record = push_margin.run(push_margin.PushMarginSettings(config, window, 100.0, step), folder,
                                      self._client, progress=False)
-            return {"margins": _margins(record), "window_source": source}
+            return {"margins": _margins(record), "window_source": source,
+                    "method": {k: record[k] for k in ("phases", "settle_s", "max_force_n", "push_duration_s")}}
 
         return self.experiment("push_margin", {"force_step_n": step, "window": list(window),
                                                "distance_m": 12.0}, run)
@@ -592,6 +593,8 @@ def _cells(record: dict) -> dict:
 def _margins(record: dict) -> dict:
     """A push-margin record's survived forces, without and with the window, forward and backward."""
     return {c: {d: record["margins"][c].get(d, {}).get("margin_n") for d in ("forward", "backward")}
+            | {f"{d}_at_grid_top": record["margins"][c].get(d, {}).get("at_grid_top", False)
+               for d in ("forward", "backward")}
             for c in ("without", "with")}
 
 
