@@ -18,9 +18,21 @@ def positive_work(torque, angular_velocity, dt: float) -> np.ndarray:
     return np.sum(np.maximum(power, 0.0), axis=0) * dt
 
 
+def _check(positive_work_j: float, mass_kg: float, distance_m: float) -> None:
+    if not (math.isfinite(positive_work_j) and positive_work_j >= 0):
+        raise ValueError(f"positive_work_j must be a finite number >= 0, got {positive_work_j!r}")
+    if not (math.isfinite(mass_kg) and mass_kg > 0):
+        raise ValueError(f"mass_kg must be positive, got {mass_kg!r}")
+    if math.isnan(distance_m):
+        raise ValueError("distance_m is NaN")
+
+
 def cost_of_transport(positive_work_j: float, mass_kg: float, distance_m: float, g: float = GRAVITY_MPS2) -> float:
-    """Dimensionless C_mt = E+ / (m g d). Not finite (inf) unless the distance is positive."""
-    if mass_kg <= 0 or g <= 0:
+    """Dimensionless C_mt = E+ / (m g d). Not finite (inf) unless the distance is positive. ValueError naming a
+    value no walk gives: positive work that is negative or not finite, a mass or g that is not a positive
+    number, a NaN distance."""
+    _check(positive_work_j, mass_kg, distance_m)
+    if not (math.isfinite(g) and g > 0):
         raise ValueError(f"mass_kg and g must be positive, got {mass_kg!r}, {g!r}")
     if not distance_m > 0:
         return math.inf
@@ -29,8 +41,7 @@ def cost_of_transport(positive_work_j: float, mass_kg: float, distance_m: float,
 
 def cost_of_transport_per_kg(positive_work_j: float, mass_kg: float, distance_m: float) -> float:
     """The paper's printed eq. 1: E+ / (kg * m), in J/(kg*m) (= g times the dimensionless C_mt)."""
-    if mass_kg <= 0:
-        raise ValueError(f"mass_kg must be positive, got {mass_kg!r}")
+    _check(positive_work_j, mass_kg, distance_m)
     if not distance_m > 0:
         return math.inf
     return positive_work_j / (mass_kg * distance_m)

@@ -14,9 +14,17 @@ __all__ = ["reward"]
 
 
 def reward(cost_of_transport: float | None, distance_m: float, target_m: float) -> float:
-    """The reward of one episode (module docstring)."""
+    """The reward of one episode (module docstring). ValueError naming a value that no episode gives: a NaN
+    C_mt (an infinite one, of a walk that covered no distance, rewards 0), a non-finite distance, or a target
+    that is not a positive number."""
+    if cost_of_transport is not None and math.isnan(cost_of_transport):
+        raise ValueError(f"reward: cost_of_transport is NaN (an episode gives a number, inf or None)")
+    if not math.isfinite(distance_m):
+        raise ValueError(f"reward: distance_m must be finite, got {distance_m!r}")
+    if not (math.isfinite(target_m) and target_m > 0):
+        raise ValueError(f"reward: target_m must be a positive number, got {target_m!r}")
     if cost_of_transport is None or not math.isfinite(cost_of_transport) or cost_of_transport <= 0:
         return 0.0
-    if distance_m <= 0 or target_m <= 0:
+    if distance_m <= 0:
         return 0.0
     return min(distance_m / target_m, 1.0) / cost_of_transport
