@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -136,6 +137,44 @@ def test_a_broken_model_is_one_line(tmp_path, capsys, name, text, message):
                                    "--out", str(tmp_path / "w")])
     assert code == 2
     one_line(lines, message.format(path=path))
+    assert not (tmp_path / "w").exists()
+
+
+def _with_torso_mesh(tmp_path, uri: str, name: str) -> Path:
+    """The shipped URDF with a visual mesh `uri` on the torso, as `name` in tmp_path (an .sdf: as SDFormat)."""
+    from sdf_of_urdf import urdf_to_sdf
+
+    from drake_biped.resources import shipped_model_file
+
+    text = shipped_model_file().read_text()
+    text = text.replace('<link name="torso">', f'<link name="torso"><visual><geometry><mesh filename="{uri}"/>'
+                                               '</geometry></visual>', 1)
+    if name.endswith(".sdf"):
+        text = urdf_to_sdf(text)
+        text = text.replace('<link name="torso">', f'<link name="torso"><visual name="look"><geometry><mesh><uri>{uri}'
+                                                   '</uri></mesh></geometry></visual>', 1)
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("name", ["mine.urdf", "mine.sdf"])
+@pytest.mark.parametrize("uri, message", [
+    ("meshes/nope.obj", "names the file 'meshes/nope.obj', which does not exist: looked for {tmp}/meshes/nope.obj "
+                        "(in the model file's folder)"),
+    ("package://nopkg/box.obj", "names the file 'package://nopkg/box.obj' in the package 'nopkg', which is unknown: "
+                                "the model file's folder {tmp} has no package.xml"),
+    ("package://drake_biped/nope.obj", "names the file 'package://drake_biped/nope.obj', which does not exist: "
+                                       "looked for "),
+])
+def test_a_models_missing_file_is_one_line_naming_it_and_where_it_was_looked_for(tmp_path, capsys, name, uri,
+                                                                                    message):
+    path = _with_torso_mesh(tmp_path, uri, name)
+    code, lines = run_cli(capsys, ["walk", "--model", str(path), "--distance", "0.1", "--no-animation",
+                                   "--out", str(tmp_path / "w")])
+    assert code == 2
+    line = one_line(lines, f"the model {name} " + message.format(tmp=tmp_path.resolve()))
+    assert "invalid when parsing a string" not in line
     assert not (tmp_path / "w").exists()
 
 

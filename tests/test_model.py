@@ -515,6 +515,36 @@ def test_a_mesh_named_relative_to_the_model_file_resolves(tmp_path):
     add_biped(DiagramBuilder(), Ground(), 1e-3, model)  # no ModelError: the relative file name resolved
 
 
+def test_a_models_file_is_found_or_named_with_where_it_was_looked_for(tmp_path):
+    """A mesh named by an absolute path resolves; a missing one, relative or absolute, and a package nobody
+    declared are ModelError naming the file and where it was looked for, through the API as on the command line."""
+    from drake_biped.episode import run_episode
+    from drake_biped.params import EpisodeConfig, RobotModel
+
+    (tmp_path / "box.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+
+    def with_mesh(uri, name):
+        visual = f'<visual><geometry><mesh filename="{uri}"/></geometry></visual>'
+        return RobotModel.from_file(_model_file(tmp_path, lambda t: t.replace('<link name="torso">',
+                                                                              f'<link name="torso">{visual}', 1), name))
+
+    build_plant(model=with_mesh(str(tmp_path / "box.obj"), "absolute.urdf"))  # no ModelError: it resolved
+    folder = tmp_path.resolve()
+    cases = [("meshes/nope.obj", f"looked for {folder / 'meshes' / 'nope.obj'} (in the model file's folder)"),
+             (str(tmp_path / "nope.obj"), f"looked for {tmp_path / 'nope.obj'}"),
+             ("package://nopkg/box.obj", f"in the package 'nopkg', which is unknown: the model file's folder {folder} "
+                                         "has no package.xml")]
+    for uri, where in cases:
+        model = with_mesh(uri, "mine.urdf")
+        with pytest.raises(ModelError) as raised:
+            run_episode(EpisodeConfig(model=model))
+        assert f"the model mine.urdf names the file {uri!r}" in str(raised.value)
+        assert where in str(raised.value) and "\n" not in str(raised.value)
+    text = with_mesh("box.obj", "mine.urdf").text  # a relative name without the folder to read it against
+    with pytest.raises(ModelError, match="relative to the model file, but the model was given as text"):
+        build_plant(model=RobotModel("mine.urdf", text))
+
+
 def test_an_sdformat_model_of_the_shipped_robot_walks_as_the_urdf(tmp_path):
     """SDFormat names actuators after their joints and has no planar joint of its own: the shipped robot written
     as SDFormat (tests/sdf_of_urdf.py) is read to the same body (to rounding: its planar frames are turned by a
