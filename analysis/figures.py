@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drake_biped.analysis import rewalks  # noqa: E402
-from drake_biped.analysis.series import moving_average, period  # noqa: E402
+from drake_biped.analysis.series import cmt_change, moving_average, period  # noqa: E402
 from drake_biped.kinematics import B_TORSO_COM_X, B_TORSO_COM_Z, TABLE_I_BODY, leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
 from drake_biped.paper import TABLE_V, TABLE_V_REDUCTION  # noqa: E402
@@ -297,8 +297,7 @@ def table_v(record: dict) -> str:
         f"{TABLE_V_PAPER['CPG with torque-free period']:.2f} | {TABLE_V_PAPER['human']:.2f} |",
         f"| ours (measured) | — | {fmt(base)} | {ours_learned} | — |",
         "",
-        f"Reduction: paper {100 * TABLE_V_REDUCTION:.0f} %, ours "
-        + ("—" if reduction is None else f"{100 * reduction:.1f} %")
+        f"C_mt change: paper {cmt_change(TABLE_V_REDUCTION, 0)}, ours {cmt_change(reduction)}"
         + ". Ours: " + _table_v_measure(record, ev) + ":",
         "",
         "| trial | t̄1 (s) | t̄2 (s) | C_mt | walked |",
@@ -311,8 +310,8 @@ def table_v(record: dict) -> str:
     if episode:
         costs = ", ".join(fmt(c) for c in episode["learned"])
         lines += ["", f"The paper's measure, one {episode['distance_m']:g} m episode from the initiation (its C_mt over "
-                  f"the whole walk): no window {fmt(episode['no_window'])}; the trials' means {costs}; reduction "
-                  + ("—" if episode.get("reduction") is None else f"{100 * episode['reduction']:.1f} %") + "."]
+                  f"the whole walk): no window {fmt(episode['no_window'])}; the trials' means {costs}; C_mt change "
+                  f"{cmt_change(episode.get('reduction'))}."]
     if ev.get("rewalks"):
         lines += ["", "## The learned windows re-walked", "", rewalks.markdown(ev["rewalks"]).rstrip()]
     return "\n".join(lines) + "\n"

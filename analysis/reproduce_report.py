@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.floquet import record_verdict
-from drake_biped.analysis.series import signed_percent
+from drake_biped.analysis.series import cmt_change, signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
 from drake_biped.records import save_figure, write_text_atomic
@@ -83,14 +83,14 @@ def reduction_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
     rewalked = evaluation.get("rewalks")
     if rewalked:
         reduction = rewalked["mean_saving"]
-        ours = (f"C_mt {_pct(None if reduction is None else -reduction)} re-walked at half the step and from "
+        ours = (f"C_mt {cmt_change(reduction)} re-walked at half the step and from "
                 f"0.95 / 1.05 × the initiation speed (± {100 * rewalked['std_saving']:.1f} % over trials; "
                 f"{rewalked['holding']} of {trials} trials save ≥ {100 * rewalked['hold_saving']:.0f} % in every "
-                f"walk); as learned {_pct(None if as_learned is None else -as_learned)}, {walks} of {trials} walk, "
+                f"walk); as learned {cmt_change(as_learned)}, {walks} of {trials} walk, "
                 f"{windows} end with a window")
     else:
         reduction = as_learned
-        ours = f"C_mt {_pct(None if reduction is None else -reduction)} (mean of the {walks} of {trials} trials " \
+        ours = f"C_mt {cmt_change(reduction)} (mean of the {walks} of {trials} trials " \
                f"that walk; {windows} end with a window; one walk each, not re-walked)"
     if reduction is None or walks == 0:
         return ours, NOT_REPRODUCED

@@ -566,7 +566,7 @@ def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, caps
     assert main(["window-map", "--out", str(tmp_path / "wm")]) == 0
     out, err = capsys.readouterr()
     assert out.splitlines() == ["no window: walked=True C_mt=0.225", "1/1 windows walk 10 m",
-                                "lowest C_mt: window (0.2, 0.5) C_mt=0.123 (-45.0 % vs no window)",
+                                "lowest C_mt: window (0.2, 0.5) C_mt=0.123 (C_mt change -45.0 % vs no window)",
                                 f"wrote {tmp_path / 'wm'}/window_map.json, window_map.csv, window_map.png"]
     assert err == ""
 

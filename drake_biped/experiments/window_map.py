@@ -206,7 +206,7 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
              f"{len(walked)}/{len(rows)} windows walk {record['config']['sim']['distance_m']:g} m"]
     if best is not None:
         lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
-                     f"({signed_percent(best['cmt_change'])} vs no window)")
+                     f"(C_mt change {signed_percent(best['cmt_change'])} vs no window)")
     return lines
 
 
