@@ -297,10 +297,13 @@ def test_a_damaged_grid_point_line_is_named_and_recomputed(tmp_path, capsys):
 
     store = tmp_path / "points.jsonl"
     store.write_text('{"key": "a", "distance_m": 1.0}\n{"key": "b", "dist\n{"key": "c", "distance_m": 2.0}\n{"ke')
+    damaged = store.read_text()
     assert sorted(read_points(store)) == ["a", "c"]
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "points.jsonl, line 2: not a grid point record" in err
-    assert store.read_text().count("\n") == 3  # the file is left as it is
+    assert err.count("\n") == 1 and "points.jsonl has 2 line(s) that do not read as a grid point record (line 2, 4" \
+        in err and "kept as points.jsonl.broken" in err
+    assert (tmp_path / "points.jsonl.broken").read_text() == damaged  # set aside as it was
+    assert [json.loads(line)["key"] for line in store.read_text().splitlines()] == ["a", "c"]
 
 
 def _drawn_ground(ground):

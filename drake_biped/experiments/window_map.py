@@ -33,7 +33,7 @@ from drake_biped.params import (
     check_settings,
     walked_the_distance,
 )
-from drake_biped.records import write_text_atomic
+from drake_biped.records import read_kept_lines, write_text_atomic
 from drake_biped.versions import versions
 
 # The most windows a map runs without force=True (--force): every one an episode held in memory before the first.
@@ -159,18 +159,14 @@ def evaluate_windows(config: EpisodeConfig, windows: list[tuple[float, float]], 
 
 
 def _read_kept_rows(path: Path | None) -> dict[str, dict]:
-    """The rows kept in `path` by configuration (its sorted JSON); a torn last line (a kill mid-write) is
-    dropped."""
-    if path is None or not Path(path).is_file():
+    """The rows kept in `path` by configuration (its sorted JSON). A line that does not read (a torn last line
+    of a kill mid-write, or damage) sets the file aside as episodes.jsonl.broken with a warning, and its episode
+    is run again (records.read_kept_lines)."""
+    if path is None:
         return {}
-    out = {}
-    for line in Path(path).read_text().splitlines():
-        try:
-            entry = json.loads(line)
-            out[json.dumps(entry["config"], sort_keys=True)] = entry["row"]
-        except (ValueError, KeyError, TypeError):
-            continue
-    return out
+    entries = read_kept_lines(path, "a window-map episode",
+                              lambda e: isinstance(e["config"], dict) and isinstance(e["row"], dict))
+    return {json.dumps(e["config"], sort_keys=True): e["row"] for e in entries}
 
 
 def run(settings: WindowMapSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
