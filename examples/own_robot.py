@@ -1,6 +1,6 @@
 """Walk a robot of your own: the shipped biped with the torso 20 % heavier and the shanks 10 % longer.
 
-    python examples/own_robot.py [--distance 10] [--out own_robot]
+    python examples/own_robot.py [--distance 10] [--out out/own_robot]
 
 The robot is a model file (URDF or SDFormat) with the shipped model's link and joint names; the controller reads
 its body (joint positions, centres of mass, foot contact spheres, masses) from the plant. Here the shipped URDF
@@ -8,7 +8,7 @@ is copied and edited: the torso's mass and inertia times 1.2; each shank's lengt
 inertia about its end for a 10 % longer uniform bar. Both robots walk the default gait from the paper's
 initiation; the table compares them. The same from the command line:
 
-    drake-biped walk --model own_robot/own_robot.urdf --out walk_own
+    drake-biped walk --model out/own_robot/own_robot.urdf --out out/walk_own
 """
 
 import xml.etree.ElementTree as ET
@@ -19,7 +19,7 @@ from drake_biped.cli import number, run_script, script_parser
 
 parser = script_parser(__doc__)
 parser.add_argument("--distance", type=number("positive"), default=10.0, help="each walk's length (m)")
-parser.add_argument("--out", default="own_robot", help="folder for the edited URDF (default own_robot)")
+parser.add_argument("--out", default="out/own_robot", help="folder for the edited URDF (default out/own_robot)")
 args = parser.parse_args()
 
 TORSO_MASS_FACTOR, SHANK_LENGTH_FACTOR = 1.2, 1.1
