@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drake_biped.analysis import rewalks  # noqa: E402
+from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval  # noqa: E402
 from drake_biped.analysis.series import cmt_change, moving_average, period  # noqa: E402
 from drake_biped.kinematics import B_TORSO_COM_X, B_TORSO_COM_Z, TABLE_I_BODY, leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
@@ -173,7 +174,7 @@ def window_map_figure(rows: list[dict], baseline_cmt: float | None, path: str | 
                     ax.text(t1s[j], t2s[i], f"{grid[i, j]:+.0f}", ha="center", va="center", fontsize=7)
     ax.set_xlabel("torque-free start t1 [s]")
     ax.set_ylabel("torque-free end t2 [s]")
-    base = f"{baseline_cmt:.3f}" if baseline_cmt else "n/a"
+    base = format_cost(baseline_cmt or None)
     ax.set_title(f"Torque-free windows: C_mt vs no window (C_mt {base}); x = fell", fontsize=9)
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
@@ -282,11 +283,12 @@ def table_v(record: dict) -> str:
     learned = ev.get("learned_mean_cost_of_transport")
 
     def fmt(x):
-        return "—" if x is None else f"{x:.3f}"
+        return format_cost(x, "—")
 
     ours_learned = fmt(learned)
     if learned is not None:
-        ours_learned += f" ± {ev['learned_std_cost_of_transport']:.3f} ({ev['learned_walks']} of {len(ev['learned'])} trials walk)"
+        ours_learned = (f"{format_cost_interval(learned, ev['learned_std_cost_of_transport'])} "
+                        f"({ev['learned_walks']} of {len(ev['learned'])} trials walk)")
     reduction = ev.get("reduction")
     lines = [
         "# Table V: cost of transport C_mt = E+ / (m g d)",

@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.floquet import record_verdict
 from drake_biped.analysis.series import cmt_change, signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
@@ -259,7 +260,7 @@ def walk_section(walk: dict[str, Any]) -> list[str]:
         "## The walk (`walk/`)",
         "",
         f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
-        f"{_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
+        f"{format_cost(walk['cost_of_transport'], '—')}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
         f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
         "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
         "",
@@ -294,8 +295,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append(("C_mt reduction, exploration matched to the gait", "—", var_ours, f"{BEYOND}; {var_verdict}"))
     cl = s["compare_learners"]
     verdicts.append(("Learners side by side: final C_mt (best window)", "—",
-                     ", ".join(f"{name} {_num(r['final_cost_of_transport'])}" for name, r in cl["learners"].items())
-                     + (f" (best window {_num(cl['best_window']['cost_of_transport'])})" if cl["best_window"]
+                     ", ".join(f"{name} {format_cost(r['final_cost_of_transport'], '—')}" for name, r in cl["learners"].items())
+                     + (f" (best window {format_cost(cl['best_window']['cost_of_transport'], '—')})" if cl["best_window"]
                         else " (no window walks)"), BEYOND))
     stab_ours, stab_verdict = stability_verdict(s["stability"]["cells"])
     verdicts.append((f"Table VI: stable under ±20 N, none vs the learned window ({wtext})", "all stable", stab_ours,
@@ -374,9 +375,9 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "## Torque-free windows of the default gait (`window_map/`)",
         "",
         f"{wm['walked']} of {wm['windows']} windows walk 10 m; no window C_mt "
-        f"{_num(wm['no_window_cost_of_transport'])}"
+        f"{format_cost(wm['no_window_cost_of_transport'], '—')}"
         + ("" if wbest is None else f"; the cheapest, {wbest['t1']:g}–{wbest['t2']:g} s, C_mt "
-           f"{_num(wbest['cost_of_transport'])} ({_pct(wbest['cmt_change'])})") + ".",
+           f"{format_cost(wbest['cost_of_transport'], '—')} ({_pct(wbest['cmt_change'])})") + ".",
         "",
         "![window map](window_map/window_map.png)",
         "",

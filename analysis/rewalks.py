@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.series import cmt_change
 
 __all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary"]
@@ -89,7 +90,7 @@ def markdown(record: dict[str, Any]) -> str:
              "C_mt change against no window (−: C_mt fell, a saving).", "",
              "| trial | window (s) | " + " | ".join(words) + " | mean | holds |",
              "|---|---|" + "---:|" * len(words) + "---:|---|"]
-    base = " | ".join(f"C_mt {measured_cost(r):.4f}" if not r["fell"] and measured_cost(r) else "falls"
+    base = " | ".join(f"C_mt {format_cost(measured_cost(r))}" if not r["fell"] and measured_cost(r) else "falls"
                       for r in record["no_window"].values())
     lines.append(f"| no window | — | {base} | | |")
     for t in record["trials"]:

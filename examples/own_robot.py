@@ -15,6 +15,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import drake_biped as db
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.cli import number, run_script, script_parser
 
 parser = script_parser(__doc__)
@@ -68,7 +69,7 @@ def main() -> None:
     print(f"{'robot':36s} {'mass kg':>8s} {'C_mt':>7s} {'speed m/s':>9s} {'step s':>7s} {'step m':>7s}  result")
     for label, config in robots.items():
         r = db.run_episode(config)
-        cmt = "-" if r.cost_of_transport is None else f"{r.cost_of_transport:.4f}"
+        cmt = format_cost(r.cost_of_transport, "-")  # 4 significant digits: a heavy robot's small C_mt is not 0
         period = "-" if r.step_period_s is None else f"{r.step_period_s:.3f}"
         length = "-" if r.step_length_m is None else f"{r.step_length_m:.3f}"
         result = f"walked {r.distance_m:.2f} m" if not r.fell else f"fell at {r.distance_m:.2f} m ({r.fall_reason})"

@@ -552,11 +552,11 @@ def test_learn_says_a_negative_saving_is_higher(tmp_path, reduction, words):
     record = {"evaluation": {"no_window": {"cost_of_transport": base}, "reduction": reduction,
                              "learned_mean_cost_of_transport": base * (1 - reduction)}}
     line = summary_lines(record, tmp_path)[1]
-    assert line == f"C_mt without a torque-free period 0.200, with the learned ones {base * (1 - reduction):.3f}: {words}"
+    assert line == f"C_mt without a torque-free period 0.2000, with the learned ones {base * (1 - reduction):.4f}: {words}"
 
 
-def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, capsys, monkeypatch):
-    # It printed C_mt=0.22461234567890123 and no "wrote" line.
+def test_window_map_prints_c_mt_to_four_significant_digits_and_what_it_wrote(tmp_path, capsys, monkeypatch):
+    # It printed C_mt=0.22461234567890123 and no "wrote" line; then 0.000 for a small C_mt.
     from contextlib import nullcontext
 
     from drake_biped.experiments import executor, window_map
@@ -568,8 +568,8 @@ def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, caps
     monkeypatch.setattr(window_map, "run", lambda settings, out, client: record)
     assert main(["window-map", "--out", str(tmp_path / "wm")]) == 0
     out, err = capsys.readouterr()
-    assert out.splitlines() == ["no window: walked=True C_mt=0.225", "1/1 windows walk 10 m",
-                                "lowest C_mt: window (0.2, 0.5) C_mt=0.123 (C_mt change -45.0 % vs no window)",
+    assert out.splitlines() == ["no window: walked=True C_mt=0.2246", "1/1 windows walk 10 m",
+                                "lowest C_mt: window (0.2, 0.5) C_mt=0.1235 (C_mt change -45.0 % vs no window)",
                                 f"wrote {tmp_path / 'wm'}/window_map.json, window_map.csv, window_map.png"]
     assert err == ""
 

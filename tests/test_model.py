@@ -356,6 +356,7 @@ def test_walk_with_a_model_file_from_another_folder(tmp_path, monkeypatch, capsy
                          "longer.urdf")
     monkeypatch.chdir(tmp_path)
     assert main(["walk", "--model", "heavy.urdf", "--distance", "1", "--no-animation", "--out", "D"]) == 0
+    assert "note:" not in capsys.readouterr().err  # 12.2 kg is within a factor of 2 of Table I's mass
     r = json.loads((tmp_path / "D" / "result.json").read_text())
     assert r["mass_kg"] == pytest.approx(12.202, abs=1e-12)
     work = r["positive_work_j"]["total"]
@@ -371,6 +372,25 @@ def test_walk_with_a_model_file_from_another_folder(tmp_path, monkeypatch, capsy
     again = json.loads((tmp_path / "D2" / "result.json").read_text())
     assert again["cost_of_transport"] == first["cost_of_transport"]
     assert again["config"]["model"]["sha256"] == first["config"]["model"]["sha256"]
+
+
+def test_a_torso_too_heavy_to_carry_falls_and_its_small_c_mt_is_printed_with_the_mass_noted(tmp_path, capsys):
+    """A 66,460 kg torso falls at once; its C_mt (E+ over a huge m g d) is small, not zero, and `walk` prints
+    it to four significant digits (it printed 0.000), with a note that the mass is far from Table I's."""
+    import json
+    import re
+
+    from drake_biped.cli import main
+
+    huge = _model_file(tmp_path, lambda t: t.replace('<mass value="6.646"/>', '<mass value="66460"/>', 1), "huge.urdf")
+    assert main(["walk", "--model", str(huge), "--no-animation", "--out", str(tmp_path / "w")]) == 0
+    out, err = capsys.readouterr()
+    r = json.loads((tmp_path / "w" / "result.json").read_text())
+    assert r["fell"] and r["distance_m"] < 0.5 and 0 < r["cost_of_transport"] < 1e-4
+    shown = float(re.search(r"C_mt (\d+\.\d+) \(E\+/\(m g d\)\)", out).group(1))
+    assert shown == pytest.approx(r["cost_of_transport"], rel=1e-3)
+    notes = [line for line in err.splitlines() if line.startswith("note:")]
+    assert len(notes) == 1 and "total mass is 66463.6 kg" in notes[0] and "Table I's 10.202 kg" in notes[0]
 
 
 def _hips_effort(value: str | None):

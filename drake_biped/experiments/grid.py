@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.experiments.options import (
     add_episode_options,
     add_resumable_run_options,
@@ -336,7 +337,7 @@ def run(settings: GridSettings, out: Path, client=None, progress: bool = True,
 def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     """The grid in two lines: how many points walk, and the best."""
     best = record["best"]
-    cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
+    cmt = format_cost(best["cost_of_transport"])
     distance = record["base_config"]["sim"]["distance_m"]
     return [f"{record['walked_the_distance']}/{record['points']} points walk {distance:g} m; best "
             f"{', '.join(f'{k}={v:.4g}' for k, v in best['point'].items())}: {best['distance_m']:.2f} m, C_mt {cmt}",

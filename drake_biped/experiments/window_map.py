@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.options import (
     add_cluster_options,
@@ -197,11 +198,10 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     baseline, rows = record["baseline"], record["windows"]
     walked = [r for r in rows if r["walked"]]
     best = min(walked, key=lambda r: r["cost_of_transport"], default=None)
-    cmt = "n/a" if baseline["cost_of_transport"] is None else f"{baseline['cost_of_transport']:.3f}"
-    lines = [f"no window: walked={baseline['walked']} C_mt={cmt}",
+    lines = [f"no window: walked={baseline['walked']} C_mt={format_cost(baseline['cost_of_transport'])}",
              f"{len(walked)}/{len(rows)} windows walk {record['config']['sim']['distance_m']:g} m"]
     if best is not None:
-        lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
+        lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={format_cost(best['cost_of_transport'])} "
                      f"(C_mt change {signed_percent(best['cmt_change'])} vs no window)")
     return lines
 
