@@ -92,6 +92,29 @@ def _skeleton(q: np.ndarray, body=TABLE_I_BODY) -> dict[str, np.ndarray]:
     return lines
 
 
+def walk_frame(trajectory: dict, time_s: float, path: str | Path, ground_height=None, body=TABLE_I_BODY) -> None:
+    """One still of the walk: the stick figure (as in walk_animation) at the recorded sample nearest `time_s`, in
+    the world's x from 0.8 m behind the hip to 0.8 m ahead, on its ground."""
+    t, q = trajectory["time"], trajectory["positions"]
+    qi = q[int(np.argmin(np.abs(np.asarray(t) - time_s)))]
+    x0 = qi[0]
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    ax.set_aspect("equal")
+    ax.set_xlim(x0 - 0.8, x0 + 0.8)
+    ax.set_ylim(-0.05, 1.0)
+    ax.set_xlabel("x [m]")
+    gx = np.linspace(x0 - 0.8, x0 + 0.8, 50)
+    ax.plot(gx, np.array([ground_height(v) for v in gx]) if ground_height else np.zeros_like(gx),
+            color="#5a8f5a", lw=2)
+    for name, pts in _skeleton(qi, body).items():
+        ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.35" if name == "torso" else COLORS[name], lw=3, ms=3)
+    ax.text(0.02, 0.93, f"t = {t[int(np.argmin(np.abs(np.asarray(t) - time_s)))]:.2f} s", transform=ax.transAxes,
+            fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, Path(path), dpi=100)
+    plt.close(fig)
+
+
 def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: int = 15,
                    max_frames: int = 300, body=TABLE_I_BODY) -> None:
     """A planar stick-figure GIF of the walk, the camera following the hip: drawn in the hip's frame
