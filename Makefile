@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 OUT ?= out
 
-.PHONY: setup reproduce walk test test-slow lint format window-map bench package-check clean
+.PHONY: setup reproduce walk test test-slow lint format window-map bench package-check clean docs-figures
 
 setup: $(VENV)/.installed
 
@@ -44,6 +44,10 @@ format: setup
 
 window-map: setup
 	$(VENV)/bin/drake-biped window-map --out $(OUT)/window-map
+
+# The pictures under docs/, drawn again from the committed records (tests/test_docs_figures.py checks them).
+docs-figures: setup
+	$(PY) benchmarks/docs_figures.py --out docs
 
 # Speed and time-step benchmarks (about 8 minutes on 2 cores): Markdown + JSON in out/bench, out/time-step-study.
 bench: setup

@@ -45,3 +45,25 @@ def cost_of_transport_per_kg(positive_work_j: float, mass_kg: float, distance_m:
     if not distance_m > 0:
         return math.inf
     return positive_work_j / (mass_kg * distance_m)
+
+
+def cost_decimals(value: float, digits: int = 4) -> int:
+    """The decimal places that show `value` to `digits` significant digits in fixed point."""
+    if value == 0 or not math.isfinite(value):
+        return digits - 1
+    return max(0, digits - 1 - math.floor(math.log10(abs(value))))
+
+
+def format_cost(value: float | None, missing: str = "n/a", digits: int = 4) -> str:
+    """A cost of transport (C_mt, or per kg) as printed: `digits` significant digits in fixed point ("0.5566",
+    "0.0001234", "12.30"), so a small C_mt that is not zero (a robot far heavier than its motors' work) never
+    reads 0.000; None as `missing`."""
+    if value is None:
+        return missing
+    return f"{value:.{cost_decimals(value, digits)}f}"
+
+
+def format_cost_interval(value: float, half_width: float, digits: int = 4) -> str:
+    """`value` ± `half_width`, both to the decimals that show `value` to `digits` significant digits."""
+    d = cost_decimals(value, digits)
+    return f"{value:.{d}f} ± {half_width:.{d}f}"

@@ -13,7 +13,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drake_biped.analysis import rewalks  # noqa: E402
-from drake_biped.analysis.series import moving_average, period  # noqa: E402
+from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval  # noqa: E402
+from drake_biped.analysis.series import cmt_change, moving_average, period  # noqa: E402
 from drake_biped.kinematics import B_TORSO_COM_X, B_TORSO_COM_Z, TABLE_I_BODY, leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
 from drake_biped.paper import TABLE_V, TABLE_V_REDUCTION  # noqa: E402
@@ -89,6 +90,29 @@ def _skeleton(q: np.ndarray, body=TABLE_I_BODY) -> dict[str, np.ndarray]:
              [p.toe_x, p.toe_z], [p.ankle_x, p.ankle_z]]
         )
     return lines
+
+
+def walk_frame(trajectory: dict, time_s: float, path: str | Path, ground_height=None, body=TABLE_I_BODY) -> None:
+    """One still of the walk: the stick figure (as in walk_animation) at the recorded sample nearest `time_s`, in
+    the world's x from 0.8 m behind the hip to 0.8 m ahead, on its ground."""
+    t, q = trajectory["time"], trajectory["positions"]
+    qi = q[int(np.argmin(np.abs(np.asarray(t) - time_s)))]
+    x0 = qi[0]
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    ax.set_aspect("equal")
+    ax.set_xlim(x0 - 0.8, x0 + 0.8)
+    ax.set_ylim(-0.05, 1.0)
+    ax.set_xlabel("x [m]")
+    gx = np.linspace(x0 - 0.8, x0 + 0.8, 50)
+    ax.plot(gx, np.array([ground_height(v) for v in gx]) if ground_height else np.zeros_like(gx),
+            color="#5a8f5a", lw=2)
+    for name, pts in _skeleton(qi, body).items():
+        ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.35" if name == "torso" else COLORS[name], lw=3, ms=3)
+    ax.text(0.02, 0.93, f"t = {t[int(np.argmin(np.abs(np.asarray(t) - time_s)))]:.2f} s", transform=ax.transAxes,
+            fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, Path(path), dpi=100)
+    plt.close(fig)
 
 
 def walk_animation(trajectory: dict, path: str | Path, ground_height=None, fps: int = 15,
@@ -173,7 +197,7 @@ def window_map_figure(rows: list[dict], baseline_cmt: float | None, path: str | 
                     ax.text(t1s[j], t2s[i], f"{grid[i, j]:+.0f}", ha="center", va="center", fontsize=7)
     ax.set_xlabel("torque-free start t1 [s]")
     ax.set_ylabel("torque-free end t2 [s]")
-    base = f"{baseline_cmt:.3f}" if baseline_cmt else "n/a"
+    base = format_cost(baseline_cmt or None)
     ax.set_title(f"Torque-free windows: C_mt vs no window (C_mt {base}); x = fell", fontsize=9)
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
@@ -282,11 +306,12 @@ def table_v(record: dict) -> str:
     learned = ev.get("learned_mean_cost_of_transport")
 
     def fmt(x):
-        return "—" if x is None else f"{x:.3f}"
+        return format_cost(x, "—")
 
     ours_learned = fmt(learned)
     if learned is not None:
-        ours_learned += f" ± {ev['learned_std_cost_of_transport']:.3f} ({ev['learned_walks']} of {len(ev['learned'])} trials walk)"
+        ours_learned = (f"{format_cost_interval(learned, ev['learned_std_cost_of_transport'])} "
+                        f"({ev['learned_walks']} of {len(ev['learned'])} trials walk)")
     reduction = ev.get("reduction")
     lines = [
         "# Table V: cost of transport C_mt = E+ / (m g d)",
@@ -297,8 +322,7 @@ def table_v(record: dict) -> str:
         f"{TABLE_V_PAPER['CPG with torque-free period']:.2f} | {TABLE_V_PAPER['human']:.2f} |",
         f"| ours (measured) | — | {fmt(base)} | {ours_learned} | — |",
         "",
-        f"Reduction: paper {100 * TABLE_V_REDUCTION:.0f} %, ours "
-        + ("—" if reduction is None else f"{100 * reduction:.1f} %")
+        f"C_mt change: paper {cmt_change(TABLE_V_REDUCTION, 0)}, ours {cmt_change(reduction)}"
         + ". Ours: " + _table_v_measure(record, ev) + ":",
         "",
         "| trial | t̄1 (s) | t̄2 (s) | C_mt | walked |",
@@ -311,8 +335,8 @@ def table_v(record: dict) -> str:
     if episode:
         costs = ", ".join(fmt(c) for c in episode["learned"])
         lines += ["", f"The paper's measure, one {episode['distance_m']:g} m episode from the initiation (its C_mt over "
-                  f"the whole walk): no window {fmt(episode['no_window'])}; the trials' means {costs}; reduction "
-                  + ("—" if episode.get("reduction") is None else f"{100 * episode['reduction']:.1f} %") + "."]
+                  f"the whole walk): no window {fmt(episode['no_window'])}; the trials' means {costs}; C_mt change "
+                  f"{cmt_change(episode.get('reduction'))}."]
     if ev.get("rewalks"):
         lines += ["", "## The learned windows re-walked", "", rewalks.markdown(ev["rewalks"]).rstrip()]
     return "\n".join(lines) + "\n"

@@ -14,8 +14,9 @@ import re
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.floquet import record_verdict
-from drake_biped.analysis.series import signed_percent
+from drake_biped.analysis.series import cmt_change, signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
 from drake_biped.records import save_figure, write_text_atomic
@@ -102,14 +103,14 @@ def reduction_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
     rewalked = evaluation.get("rewalks")
     if rewalked:
         reduction = rewalked["mean_saving"]
-        ours = (f"C_mt {_pct(None if reduction is None else -reduction)} re-walked at half the step and from "
+        ours = (f"C_mt {cmt_change(reduction)} re-walked at half the step and from "
                 f"0.95 / 1.05 × the initiation speed (± {100 * rewalked['std_saving']:.1f} % over trials; "
                 f"{rewalked['holding']} of {trials} trials save ≥ {100 * rewalked['hold_saving']:.0f} % in every "
-                f"walk); as learned {_pct(None if as_learned is None else -as_learned)}, {walks} of {trials} walk, "
+                f"walk); as learned {cmt_change(as_learned)}, {walks} of {trials} walk, "
                 f"{windows} end with a window")
     else:
         reduction = as_learned
-        ours = f"C_mt {_pct(None if reduction is None else -reduction)} (mean of the {walks} of {trials} trials " \
+        ours = f"C_mt {cmt_change(reduction)} (mean of the {walks} of {trials} trials " \
                f"that walk; {windows} end with a window; one walk each, not re-walked)"
     if reduction is None or walks == 0:
         return ours, NOT_REPRODUCED
@@ -295,7 +296,7 @@ def walk_section(walk: dict[str, Any]) -> list[str]:
         "## The walk (`walk/`)",
         "",
         f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
-        f"{_num(walk['cost_of_transport'])}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
+        f"{format_cost(walk['cost_of_transport'], '—')}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
         f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
         "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
         "",
@@ -331,8 +332,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     verdicts.append(("C_mt reduction, exploration matched to the gait", "—", var_ours, f"{BEYOND}; {var_verdict}"))
     cl = s["compare_learners"]
     verdicts.append(("Learners side by side: final C_mt (best window)", "—",
-                     ", ".join(f"{name} {_num(r['final_cost_of_transport'])}" for name, r in cl["learners"].items())
-                     + (f" (best window {_num(cl['best_window']['cost_of_transport'])})" if cl["best_window"]
+                     ", ".join(f"{name} {format_cost(r['final_cost_of_transport'], '—')}" for name, r in cl["learners"].items())
+                     + (f" (best window {format_cost(cl['best_window']['cost_of_transport'], '—')})" if cl["best_window"]
                         else " (no window walks)"), BEYOND))
     stab_ours, stab_verdict = stability_verdict(s["stability"]["cells"])
     verdicts.append((f"Table VI: stable under ±20 N, none vs the learned window ({wtext})", "all stable", stab_ours,
@@ -411,9 +412,9 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "## Torque-free windows of the default gait (`window_map/`)",
         "",
         f"{wm['walked']} of {wm['windows']} windows walk {profile.distance_m:g} m; no window C_mt "
-        f"{_num(wm['no_window_cost_of_transport'])}"
+        f"{format_cost(wm['no_window_cost_of_transport'], '—')}"
         + ("" if wbest is None else f"; the cheapest, {wbest['t1']:g}–{wbest['t2']:g} s, C_mt "
-           f"{_num(wbest['cost_of_transport'])} ({_pct(wbest['cmt_change'])})") + ".",
+           f"{format_cost(wbest['cost_of_transport'], '—')} ({_pct(wbest['cmt_change'])})") + ".",
         "",
         "![window map](window_map/window_map.png)",
         "",

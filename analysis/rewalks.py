@@ -15,8 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import measure_text
-from drake_biped.analysis.series import signed_percent, window_text
+from drake_biped.analysis.series import cmt_change, window_text
 
 __all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary"]
 
@@ -75,7 +76,7 @@ def summary(time_step_s: float, speed_mps: float, learned: list[dict[str, Any]],
 
 def _change(saving: float | None) -> str:
     """A saving as the C_mt change it is ("-45.0 %"), or "falls"."""
-    return "falls" if saving is None else signed_percent(-saving)
+    return "falls" if saving is None else cmt_change(saving)
 
 
 def markdown(record: dict[str, Any]) -> str:
@@ -89,9 +90,10 @@ def markdown(record: dict[str, Any]) -> str:
              f"{record['speed_mps']:g} m/s"
              + (f"; {measure_text(record['distance_m'])}" if record.get("distance_m") else "")
              + f"). A trial holds when it saves ≥ {100 * record['hold_saving']:.0f} % in every walk.", "",
+             "C_mt change against no window (−: C_mt fell, a saving).", "",
              "| trial | window | " + " | ".join(words) + " | mean | holds |",
              "|---|---|" + "---:|" * len(words) + "---:|---|"]
-    base = " | ".join(f"C_mt {measured_cost(r):.4f}" if not r["fell"] and measured_cost(r) else "falls"
+    base = " | ".join(f"C_mt {format_cost(measured_cost(r))}" if not r["fell"] and measured_cost(r) else "falls"
                       for r in record["no_window"].values())
     lines.append(f"| no window | — | {base} | | |")
     for t in record["trials"]:
@@ -108,7 +110,7 @@ def headline(record: dict[str, Any]) -> str:
     n = len(record["trials"])
     if record["mean_saving"] is None:
         return f"No trial's window walks under any change ({n} trials)."
-    return (f"C_mt change with the learned windows, re-walked: {signed_percent(-record['mean_saving'])} "
+    return (f"C_mt change with the learned windows, re-walked: {cmt_change(record['mean_saving'])} "
             f"(± {100 * record['std_saving']:.1f} %, mean over trials of each trial's mean over its "
             f"{len(record['changes'])} walks); {record['holding']} of {n} trials save ≥ "
             f"{100 * record['hold_saving']:.0f} % in every walk.")

@@ -18,7 +18,7 @@ def reward(cost_of_transport: float | None, distance_m: float, target_m: float) 
     C_mt (an infinite one, of a walk that covered no distance, rewards 0), a non-finite distance, or a target
     that is not a positive number."""
     if cost_of_transport is not None and math.isnan(cost_of_transport):
-        raise ValueError(f"reward: cost_of_transport is NaN (an episode gives a number, inf or None)")
+        raise ValueError("reward: cost_of_transport is NaN (an episode gives a number, inf or None)")
     if not math.isfinite(distance_m):
         raise ValueError(f"reward: distance_m must be finite, got {distance_m!r}")
     if not (math.isfinite(target_m) and target_m > 0):

@@ -38,11 +38,17 @@ def window_text(t1: float, t2: float, digits: int = 3) -> str:
 
 
 def signed_percent(fraction: float | None, digits: int = 1) -> str:
-    """A fraction as a signed percentage ("+12.3 %", "-4.0 %"); one that rounds to zero prints "0.0 %", never
-    "-0.0 %"; None prints "—"."""
+    """A fractional change as a signed percentage ("+12.3 %" a rise, "-4.0 %" a fall); one that rounds to zero
+    prints "0.0 %", never "-0.0 %"; None prints "—"."""
     if fraction is None:
         return "—"
     value = round(100.0 * fraction, digits)
     if value == 0:
         return f"{0:.{digits}f} %"
     return f"{value:+.{digits}f} %"
+
+
+def cmt_change(saving: float | None, digits: int = 1) -> str:
+    """A C_mt saving (1 - C_mt / C_mt without a window) as the signed C_mt change it is: every report signs C_mt
+    as a change, so a saving of 0.377 is "-37.7 %" (C_mt fell) and a negative saving "+..." (it rose); None "—"."""
+    return signed_percent(None if saving is None else -saving, digits)

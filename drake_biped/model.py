@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import numpy as np
 from pydrake.geometry import (
@@ -29,7 +31,7 @@ from pydrake.geometry import (
     Sphere,
 )
 from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.multibody.parsing import Parser
+from pydrake.multibody.parsing import PackageMap, Parser
 from pydrake.multibody.plant import (
     AddMultibodyPlant,
     CoulombFriction,
@@ -163,11 +165,12 @@ def parse_model(parser: Parser, model: RobotModel | None = None) -> None:
     name = MODEL_URL if model is None else model.name
     if model is not None:
         _check_masses(model)
+        text = _with_resolved_files(model, packages)
     try:
         if model is None:
             parser.AddModels(url=MODEL_URL)
         else:
-            parser.AddModelsFromString(_with_absolute_files(model), model.format)
+            parser.AddModelsFromString(text, model.format)
     except Exception as exc:  # Drake raises RuntimeError with the parser's message
         detail = " ".join(str(exc).split())
         if model is not None:  # Drake names a text it parsed "<literal-string>.urdf": name the file
@@ -175,24 +178,62 @@ def parse_model(parser: Parser, model: RobotModel | None = None) -> None:
         raise ModelError(f"could not parse the model {name}: {detail}") from exc
 
 
-def _with_absolute_files(model: RobotModel) -> str:
-    """The model's text with each relative file name (a URDF `filename="..."`, an SDFormat `<uri>`) made absolute
-    against the folder the file was read from: a text parsed from a string has no folder of its own. URIs
-    with a scheme (package://, file://) and absolute paths are kept."""
-    import re
+def _with_resolved_files(model: RobotModel, packages: PackageMap) -> str:
+    """The model's text with each file it names (a URDF `filename="..."`, an SDFormat `<uri>`) checked and, when
+    it is a path, made a file:// URI: a text parsed from a string has no folder of its own, so a relative name
+    is read against the folder the model file was read from, and Drake takes no bare path in it at all.
 
-    if not model.directory:
-        return model.text
-    folder = Path(model.directory)
+    ModelError naming the file and where it was looked for when it is not there: a relative name in the model
+    file's folder, a package:// (SDFormat model://) URI in its package, which must be known (the package.xml
+    beside the model file, the shipped drake_biped, Drake's own). Other schemes are left to Drake."""
+    folder = Path(model.directory) if model.directory else None
 
-    def absolute(value: str) -> str:
-        if "://" in value or Path(value).is_absolute() or not (folder / value).exists():
+    def missing(value: str, looked: str) -> ModelError:
+        return ModelError(f"the model {model.name} names the file {value!r}, which does not exist: looked for "
+                          f"{looked}")
+
+    def package_file(value: str, scheme: str) -> None:
+        package, _, rest = value[len(scheme) + 3:].partition("/")
+        if not packages.Contains(package):
+            if model.package_xml and Path(model.package_xml).is_file():
+                beside = f"the package.xml beside the model file ({model.package_xml}) declares another"
+            elif folder is not None:
+                beside = f"the model file's folder {folder} has no package.xml"
+            else:
+                beside = "the model was given as text, without the folder of a package.xml"
+            raise ModelError(f"the model {model.name} names the file {value!r} in the package {package!r}, which "
+                             f"is unknown: {beside}; the known packages are {sorted(packages.GetPackageNames())}")
+        root = Path(packages.GetPath(package))
+        if not (root / rest).exists():
+            raise missing(value, f"{root / rest} (the package {package!r} is {root})")
+
+    def checked(value: str) -> str:
+        scheme = urlparse(value).scheme if "://" in value else ""
+        if scheme in ("package", "model"):
+            package_file(value, scheme)
             return value
+        if scheme == "file":
+            if not Path(unquote(urlparse(value).path)).exists():
+                raise missing(value, unquote(urlparse(value).path))
+            return value
+        if scheme:
+            return value  # another scheme: Drake's to resolve or name
+        if Path(value).is_absolute():
+            if not Path(value).exists():
+                raise missing(value, value)
+            return Path(value).resolve().as_uri()
+        if folder is None:
+            raise ModelError(f"the model {model.name} names the file {value!r} relative to the model file, but "
+                             "the model was given as text without its folder: give it as a file "
+                             "(RobotModel.from_file(path))")
+        if not (folder / value).exists():
+            raise missing(value, f"{folder / value} (in the model file's folder)")
         return (folder / value).resolve().as_uri()
 
     if model.format == "urdf":
-        return re.sub(r'filename="([^"]+)"', lambda m: f'filename="{absolute(m.group(1))}"', model.text)
-    return re.sub(r"<uri>\s*([^<]+?)\s*</uri>", lambda m: f"<uri>{absolute(m.group(1))}</uri>", model.text)
+        return re.sub(r"""filename=(["'])(.+?)\1""",
+                      lambda m: f"filename={m.group(1)}{checked(m.group(2))}{m.group(1)}", model.text)
+    return re.sub(r"<uri>\s*([^<]+?)\s*</uri>", lambda m: f"<uri>{checked(m.group(1))}</uri>", model.text)
 
 
 # A level-then-slope ground's boxes: the level part from GROUND_BEHIND_M (behind the start) to the slope's foot,

@@ -5,15 +5,15 @@ from __future__ import annotations
 import json
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from drake_biped.params import ParameterError
 
-__all__ = ["LOCK_FILE", "RUN_FILE", "atomic_file", "claim_folder", "read_json", "read_kept", "save_figure", "set_aside", "warn", "write_atomic",
-           "write_text_atomic"]
+__all__ = ["LOCK_FILE", "RUN_FILE", "atomic_file", "claim_folder", "read_json", "read_kept", "read_kept_lines",
+           "save_figure", "set_aside", "warn", "write_atomic", "write_text_atomic"]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -83,6 +83,40 @@ def read_kept(path: Path) -> Any | None:
     except (json.JSONDecodeError, UnicodeDecodeError):
         set_aside(path, "is not valid JSON (a damaged result); it is computed again")
         return None
+
+
+def read_kept_lines(path: Path, what: str, readable: Callable[[Any], bool] = lambda entry: True,
+                    in_order: bool = False) -> list[Any]:
+    """The entries of a JSON-lines log a resumable run appends to (a finished episode, point or generation a
+    line), [] when there is none. When a line does not read (JSON for which `readable` holds), the file is set
+    aside as PATH.broken with a warning naming the lines, and PATH is written again with the lines that read
+    (with `in_order`, a log whose lines build on each other, those before the first that does not): what was
+    lost is computed again, and nothing is deleted."""
+    path = Path(path)
+    if not path.is_file():
+        return []
+    lines = path.read_text(errors="replace").splitlines()
+    kept, bad = [], []
+    for number, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            entry = json.loads(line)
+            ok = readable(entry)
+        except (ValueError, KeyError, TypeError, AttributeError, RecursionError):
+            ok = False
+        if not ok:
+            bad.append(number)
+        elif not (in_order and bad):
+            kept.append((line, entry))
+    if bad:
+        shown = ", ".join(str(n) for n in bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
+        which = "before the first" if in_order else "that read"
+        set_aside(path, f"has {len(bad)} line(s) that do not read as {what} (line {shown}: a damaged log or a write "
+                  f"cut short); the {len(kept)} {which} carry over into a new {path.name}, the rest are computed "
+                  "again")
+        write_text_atomic(path, "".join(line + "\n" for line, _ in kept))
+    return [entry for _, entry in kept]
 
 
 @contextmanager

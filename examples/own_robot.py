@@ -1,6 +1,6 @@
 """Walk a robot of your own: the shipped biped with the torso 20 % heavier and the shanks 10 % longer.
 
-    python examples/own_robot.py [--distance 10] [--out own_robot]
+    python examples/own_robot.py [--distance 10] [--out out/own_robot]
 
 The robot is a model file (URDF or SDFormat) with the shipped model's link and joint names; the controller reads
 its body (joint positions, centres of mass, foot contact spheres, masses) from the plant. Here the shipped URDF
@@ -8,18 +8,19 @@ is copied and edited: the torso's mass and inertia times 1.2; each shank's lengt
 inertia about its end for a 10 % longer uniform bar. Both robots walk the default gait from the paper's
 initiation; the table compares them. The same from the command line:
 
-    drake-biped walk --model own_robot/own_robot.urdf --out walk_own
+    drake-biped walk --model out/own_robot/own_robot.urdf --out out/walk_own
 """
 
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import drake_biped as db
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.cli import number, run_script, script_parser
 
 parser = script_parser(__doc__)
 parser.add_argument("--distance", type=number("positive"), default=10.0, help="each walk's length (m)")
-parser.add_argument("--out", default="own_robot", help="folder for the edited URDF (default own_robot)")
+parser.add_argument("--out", default="out/own_robot", help="folder for the edited URDF (default out/own_robot)")
 args = parser.parse_args()
 
 TORSO_MASS_FACTOR, SHANK_LENGTH_FACTOR = 1.2, 1.1
@@ -68,7 +69,7 @@ def main() -> None:
     print(f"{'robot':36s} {'mass kg':>8s} {'C_mt':>7s} {'speed m/s':>9s} {'step s':>7s} {'step m':>7s}  result")
     for label, config in robots.items():
         r = db.run_episode(config)
-        cmt = "-" if r.cost_of_transport is None else f"{r.cost_of_transport:.4f}"
+        cmt = format_cost(r.cost_of_transport, "-")  # 4 significant digits: a heavy robot's small C_mt is not 0
         period = "-" if r.step_period_s is None else f"{r.step_period_s:.3f}"
         length = "-" if r.step_length_m is None else f"{r.step_length_m:.3f}"
         result = f"walked {r.distance_m:.2f} m" if not r.fell else f"fell at {r.distance_m:.2f} m ({r.fall_reason})"

@@ -11,6 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 import drake_biped as db  # noqa: E402
+from drake_biped.analysis.cost_of_transport import format_cost  # noqa: E402
 from drake_biped.cli import number, run_script, script_parser  # noqa: E402  (the commands' option checks)
 
 parser = script_parser(__doc__)
@@ -25,7 +26,7 @@ def main() -> None:
     config = db.EpisodeConfig(window=db.TorqueFreeWindow(args.t1, args.t2)).override({"sim.distance_m": args.distance})
     result = db.run_episode(config, record_trajectory=True)
     print(f"walked {result.distance_m:.2f} m in {result.duration_s:.2f} s, fell: {result.fell}, "
-          f"{len(result.steps)} steps, C_mt {result.cost_of_transport or float('nan'):.3f}, "
+          f"{len(result.steps)} steps, C_mt {format_cost(result.cost_of_transport)}, "
           f"real-time factor {result.real_time_factor:.1f}")
 
     traj = result.trajectory  # arrays: time, positions (x, z, pitch, then JOINT_NAMES), torque_free, ...

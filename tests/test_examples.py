@@ -1,5 +1,6 @@
 """Every script in examples/ runs on a short setting and prints what it promises (each is a subprocess, run
-from outside the checkout, as a user would run a copied script)."""
+from outside the checkout, as a user would run a copied script), and writes only under out/ or the folder it is
+given."""
 
 import re
 import subprocess
@@ -18,6 +19,11 @@ def run(tmp_path, script: str, *args: str) -> str:
     return out.stdout
 
 
+def written(folder: Path) -> list[str]:
+    """Every file under `folder` (the folder a script ran in), as paths relative to it."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
+
+
 def test_every_example_has_a_test():
     tested = set(re.findall(r'"(\w+\.py)"', Path(__file__).read_text()))
     assert {p.name for p in EXAMPLES.glob("*.py")} <= tested
@@ -29,6 +35,7 @@ def test_walk_and_plot(tmp_path):
     assert re.search(r"walked 2\.\d\d m .* fell: False", text)
     assert (tmp_path / "walk" / "hip_angles.png").stat().st_size > 10_000
     assert '"cost_of_transport"' in (tmp_path / "walk" / "result.json").read_text()
+    assert written(tmp_path) == ["walk/hip_angles.png", "walk/result.json"]  # only where it was told
 
 
 @pytest.mark.slow
@@ -37,6 +44,7 @@ def test_window_sweep(tmp_path):
     changes = [float(x) for x in re.findall(r"\(([+-]\d+\.\d) % vs none\)", text)]
     assert len(changes) == 2 and changes[0] < 0  # 0.2-0.5 s saves energy on the default gait
     assert "window 0.2-0.5 s: walks" in text
+    assert written(tmp_path) == []
 
 
 @pytest.mark.slow
@@ -45,6 +53,7 @@ def test_garb_loop(tmp_path):
     rewards = [float(x) for x in re.findall(r"reward (\d+\.\d+)", text)]
     assert len(rewards) == 3 and all(r > 0 for r in rewards)
     assert text.count("policy mean") == 3
+    assert written(tmp_path) == []
 
 
 @pytest.mark.slow
@@ -53,12 +62,14 @@ def test_return_map(tmp_path):
     radius = float(re.search(r"spectral radius (\d+\.\d+)", text).group(1))
     assert 0 < radius < 1  # the default gait is a stable limit cycle
     assert text.count("touchdowns") == 3
+    assert written(tmp_path) == []
 
 
 @pytest.mark.slow
 def test_dask_sweep(tmp_path):
     text = run(tmp_path, "dask_sweep.py", "--workers", "2", "--distance", "1.5")
     assert text.count("C_mt") == 6 and "no window: 1.5" in text
+    assert written(tmp_path) == []  # nor a Dask scratch folder
 
 
 @pytest.mark.slow
@@ -69,6 +80,7 @@ def test_custom_learner(tmp_path):
     assert len(cmt) == 4 and text.count("best window so far") == 4
     best = re.findall(r"best window so far \((\d\.\d+), (\d\.\d+)\)", text)
     assert best[0] == ("0.300", "0.400")  # the first episode walks the start itself
+    assert written(tmp_path) == []
 
 
 BAD_ARGUMENTS = [  # (script, arguments, what the one line names); once tracebacks, or exit 0 saying nothing
@@ -106,12 +118,14 @@ def test_a_failed_run_of_an_example_is_one_line_with_exit_code_1(tmp_path):
 
 
 def test_own_robot(tmp_path):
-    text = run(tmp_path, "own_robot.py", "--distance", "1.5", "--out", "robot")
+    """Without --out the edited URDF goes to out/own_robot, never into the folder the script runs in."""
+    text = run(tmp_path, "own_robot.py", "--distance", "1.5")
+    assert written(tmp_path) == ["out/own_robot/own_robot.urdf"]
     rows = {line.split()[0]: line[36:].split() for line in text.splitlines() if line.startswith(("shipped", "own"))}
     assert list(rows) == ["shipped", "own:"]
     # the model's mass: the torso 20 % heavier, the shanks as heavy as before
     assert float(rows["shipped"][0]) == 10.202
     assert float(rows["own:"][0]) == pytest.approx(10.202 + 0.2 * 6.646, abs=1e-3)
     assert all(row[5] in ("walked", "fell") for row in rows.values())
-    urdf = (tmp_path / "robot" / "own_robot.urdf").read_text()
+    urdf = (tmp_path / "out" / "own_robot" / "own_robot.urdf").read_text()
     assert '<origin xyz="0 0 -0.3487" />' in urdf  # the ankle 10 % further down the shank

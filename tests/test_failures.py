@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -155,6 +156,44 @@ def test_a_broken_model_is_one_line(tmp_path, capsys, name, text, message):
     assert not (tmp_path / "w").exists()
 
 
+def _with_torso_mesh(tmp_path, uri: str, name: str) -> Path:
+    """The shipped URDF with a visual mesh `uri` on the torso, as `name` in tmp_path (an .sdf: as SDFormat)."""
+    from sdf_of_urdf import urdf_to_sdf
+
+    from drake_biped.resources import shipped_model_file
+
+    text = shipped_model_file().read_text()
+    text = text.replace('<link name="torso">', f'<link name="torso"><visual><geometry><mesh filename="{uri}"/>'
+                                               '</geometry></visual>', 1)
+    if name.endswith(".sdf"):
+        text = urdf_to_sdf(text)
+        text = text.replace('<link name="torso">', f'<link name="torso"><visual name="look"><geometry><mesh><uri>{uri}'
+                                                   '</uri></mesh></geometry></visual>', 1)
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("name", ["mine.urdf", "mine.sdf"])
+@pytest.mark.parametrize("uri, message", [
+    ("meshes/nope.obj", "names the file 'meshes/nope.obj', which does not exist: looked for {tmp}/meshes/nope.obj "
+                        "(in the model file's folder)"),
+    ("package://nopkg/box.obj", "names the file 'package://nopkg/box.obj' in the package 'nopkg', which is unknown: "
+                                "the model file's folder {tmp} has no package.xml"),
+    ("package://drake_biped/nope.obj", "names the file 'package://drake_biped/nope.obj', which does not exist: "
+                                       "looked for "),
+])
+def test_a_models_missing_file_is_one_line_naming_it_and_where_it_was_looked_for(tmp_path, capsys, name, uri,
+                                                                                    message):
+    path = _with_torso_mesh(tmp_path, uri, name)
+    code, lines = run_cli(capsys, ["walk", "--model", str(path), "--distance", "0.1", "--no-animation",
+                                   "--out", str(tmp_path / "w")])
+    assert code == 2
+    line = one_line(lines, f"the model {name} " + message.format(tmp=tmp_path.resolve()))
+    assert "invalid when parsing a string" not in line
+    assert not (tmp_path / "w").exists()
+
+
 def test_a_failed_run_is_one_line_with_exit_code_1_and_a_traceback_on_request(tmp_path, capsys, monkeypatch):
     from drake_biped.experiments import walk
 
@@ -287,10 +326,13 @@ def test_a_damaged_grid_point_line_is_named_and_recomputed(tmp_path, capsys):
 
     store = tmp_path / "points.jsonl"
     store.write_text('{"key": "a", "distance_m": 1.0}\n{"key": "b", "dist\n{"key": "c", "distance_m": 2.0}\n{"ke')
+    damaged = store.read_text()
     assert sorted(read_points(store)) == ["a", "c"]
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "points.jsonl, line 2: not a grid point record" in err
-    assert store.read_text().count("\n") == 3  # the file is left as it is
+    assert err.count("\n") == 1 and "points.jsonl has 2 line(s) that do not read as a grid point record (line 2, 4" \
+        in err and "kept as points.jsonl.broken" in err
+    assert (tmp_path / "points.jsonl.broken").read_text() == damaged  # set aside as it was
+    assert [json.loads(line)["key"] for line in store.read_text().splitlines()] == ["a", "c"]
 
 
 def _drawn_ground(ground):
@@ -539,11 +581,11 @@ def test_learn_says_a_negative_saving_is_higher(tmp_path, reduction, words):
     record = {"evaluation": {"no_window": {"cost_of_transport": base}, "reduction": reduction,
                              "learned_mean_cost_of_transport": base * (1 - reduction)}}
     line = summary_lines(record, tmp_path)[1]
-    assert line == f"C_mt without a torque-free period 0.200, with the learned ones {base * (1 - reduction):.3f}: {words}"
+    assert line == f"C_mt without a torque-free period 0.2000, with the learned ones {base * (1 - reduction):.4f}: {words}"
 
 
-def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, capsys, monkeypatch):
-    # It printed C_mt=0.22461234567890123 and no "wrote" line.
+def test_window_map_prints_c_mt_to_four_significant_digits_and_what_it_wrote(tmp_path, capsys, monkeypatch):
+    # It printed C_mt=0.22461234567890123 and no "wrote" line; then 0.000 for a small C_mt.
     from contextlib import nullcontext
 
     from drake_biped.experiments import executor, window_map
@@ -555,8 +597,8 @@ def test_window_map_prints_c_mt_to_three_digits_and_what_it_wrote(tmp_path, caps
     monkeypatch.setattr(window_map, "run", lambda settings, out, client: record)
     assert main(["window-map", "--out", str(tmp_path / "wm")]) == 0
     out, err = capsys.readouterr()
-    assert out.splitlines() == ["no window: walked=True C_mt=0.225", "1/1 windows walk 10 m",
-                                "lowest C_mt: window (0.2, 0.5) C_mt=0.123 (-45.0 % vs no window)",
+    assert out.splitlines() == ["no window: walked=True C_mt=0.2246", "1/1 windows walk 10 m",
+                                "lowest C_mt: window (0.2, 0.5) C_mt=0.1235 (C_mt change -45.0 % vs no window)",
                                 f"wrote {tmp_path / 'wm'}/window_map.json, window_map.csv, window_map.png"]
     assert err == ""
 

@@ -29,7 +29,7 @@ def test_mutation_changes_every_listed_parameter_within_bounds():
     assert child.initial == c.initial and child.sim == c.sim
 
 
-def test_search_keeps_the_best_parent_and_resumes(tmp_path, client):
+def test_search_keeps_the_best_parent_and_resumes(tmp_path, client, capsys):
     start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
     kwargs = dict(offspring=2, sigma=0.3, seed=4, distance_m=0.3, windows=((0.1, 0.2),))
     run(GaitSearchSettings(start, generations=2, **kwargs), tmp_path, client, progress=False)
@@ -47,6 +47,17 @@ def test_search_keeps_the_best_parent_and_resumes(tmp_path, client):
     assert [r["generation"] for r in records] == [0, 1, 2, 3]
     best = EpisodeConfig.from_dict(json.loads((tmp_path / "best_config.json").read_text()))
     assert best.to_dict() == records[-1]["parent"]
+    assert (tmp_path / "search.jsonl.broken").is_file()
+    # A damaged generation in the middle: the log is set aside with a warning, and the search resumes after the
+    # generation before it, to the same generations.
+    lines = (tmp_path / "search.jsonl").read_text().splitlines()
+    damaged = "\n".join([lines[0], lines[1][:40], *lines[2:]]) + "\n"
+    (tmp_path / "search.jsonl").write_text(damaged)
+    capsys.readouterr()
+    run(GaitSearchSettings(start, generations=3, **kwargs), tmp_path, client, progress=False)
+    assert "search.jsonl has 1 line(s) that do not read as a gait-search generation (line 2" in capsys.readouterr().err
+    assert (tmp_path / "search.jsonl.broken-2").read_text() == damaged
+    assert _read_log(tmp_path / "search.jsonl") == records
 
 
 def test_paper_mutations_hold_the_cpg_and_the_initiation():

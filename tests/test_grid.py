@@ -129,7 +129,8 @@ def test_tiny_grid_finds_the_walking_point_and_a_rerun_recomputes_nothing(tmp_pa
     (out / "points.jsonl").write_text(text[0] + text[1][:25])
     assert main(argv) == 0
     lines = (out / "points.jsonl").read_text().splitlines()
-    assert len(lines) == 3 and len(read_points(out / "points.jsonl")) == 2  # the half line, skipped
+    assert len(lines) == 2 and len(read_points(out / "points.jsonl")) == 2  # the half line set aside, run again
+    assert (out / "points.jsonl.broken").read_text() == text[0] + text[1][:25]
     assert json.loads((out / "grid.json").read_text()) == record
     # The run log counts what each session computed: 2 points, then none, then the one lost.
     assert [x["episodes"] for x in json.loads((out / "run.json").read_text())["sessions"]] == [2, 0, 1]

@@ -55,3 +55,38 @@ def test_compare_without_a_walking_window_reports_no_distance():
               "trials": [{"final_mean": [0.2, 0.8], "episodes": [_episode(0.2)]}]}
     row = compare(record, None)
     assert row["mean_distance_to_best_s"] is None and row["episodes_to_within"] == [None] and row["reached"] == 0
+
+
+def test_compare_learners_and_learn_sign_the_same_reduction_the_same_way():
+    """A learned window that lowers C_mt by 37.7 % (as learned and re-walked) is "-37.7 %" in compare-learners'
+    table and in learn's Table V and re-walk table alike: every signed percentage of C_mt is a change (- a fall),
+    never a "+" for a saving in one report and for a rise in another."""
+    import re
+
+    from drake_biped.analysis import rewalks
+    from drake_biped.analysis.figures import table_v
+    from drake_biped.experiments.compare_learners import markdown
+
+    base, learned = 0.6, 0.6 * (1 - 0.377)
+    walk = {"cost_of_transport": learned, "fell": False, "distance_m": 10.0}
+    none = {"cost_of_transport": base, "fell": False, "distance_m": 10.0}
+    rows = {c: {"no_window": none, 0: walk} for c in rewalks.CHANGES}
+    evaluation = {"no_window": {"cost_of_transport": base, "fell": False}, "learned_walks": 1,
+                  "learned": [{"trial": 0, "t1": 0.3, "t2": 0.6, "cost_of_transport": learned, "fell": False}],
+                  "learned_mean_cost_of_transport": learned, "learned_std_cost_of_transport": 0.0,
+                  "reduction": 1 - learned / base, "measure": "long-run C_mt",
+                  "rewalks": rewalks.summary(1e-3, 0.175, [{"trial": 0, "t1": 0.3, "t2": 0.6}], rows)}
+    record = {"evaluation": evaluation,
+              "trials": [{"trial": 0, "final_mean": [0.3, 0.6], "episodes": [_episode(learned)]}]}
+    comparison = {"best_window": {"t1": 0.3, "t2": 0.6, "cost_of_transport": learned},
+                  "no_window_cost_of_transport": base,
+                  "settings": {"trials": 1, "episodes": 1, "mean": [0.5, 0.5], "variance": 0.04},
+                  "learners": {"garb": {**compare(record, None), "wall_s": 60.0}}}
+    learn_table, compare_table = table_v({"settings": {}, **record}), markdown(comparison)
+    garb_row = next(line for line in compare_table.splitlines() if line.startswith("| garb |"))
+    assert garb_row.count("-37.7 %") == 2  # the C_mt change as learned and re-walked
+    assert "C_mt change: paper -50 %, ours -37.7 %" in learn_table
+    assert "| 0 | 0.300–0.600 s | -37.7 % | -37.7 % | -37.7 % | -37.7 % | -37.7 % | yes |" in learn_table
+    for table in (learn_table, compare_table):
+        assert not re.search(r"\+37\.7", table), table
+        assert "C_mt change" in table

@@ -171,7 +171,7 @@ def test_figures_are_redrawn_from_the_records_alone(tmp_path):
         assert (tmp_path / name).stat().st_size > 0
     table = (tmp_path / "table_v.md").read_text()
     assert "| paper | 1.60 | 0.58 | 0.29 | 0.05 |" in table
-    assert "0.221" in table and "0.150 ± 0.010" in table and "32.1 %" in table
+    assert "0.221" in table and "0.1500 ± 0.0100" in table and "C_mt change: paper -50 %, ours -32.1 %" in table
 
 
 def test_figures_without_a_record_is_a_clear_error(tmp_path, capsys):

@@ -356,6 +356,7 @@ def test_walk_with_a_model_file_from_another_folder(tmp_path, monkeypatch, capsy
                          "longer.urdf")
     monkeypatch.chdir(tmp_path)
     assert main(["walk", "--model", "heavy.urdf", "--distance", "1", "--no-animation", "--out", "D"]) == 0
+    assert "note:" not in capsys.readouterr().err  # 12.2 kg is within a factor of 2 of Table I's mass
     r = json.loads((tmp_path / "D" / "result.json").read_text())
     assert r["mass_kg"] == pytest.approx(12.202, abs=1e-12)
     work = r["positive_work_j"]["total"]
@@ -371,6 +372,25 @@ def test_walk_with_a_model_file_from_another_folder(tmp_path, monkeypatch, capsy
     again = json.loads((tmp_path / "D2" / "result.json").read_text())
     assert again["cost_of_transport"] == first["cost_of_transport"]
     assert again["config"]["model"]["sha256"] == first["config"]["model"]["sha256"]
+
+
+def test_a_torso_too_heavy_to_carry_falls_and_its_small_c_mt_is_printed_with_the_mass_noted(tmp_path, capsys):
+    """A 66,460 kg torso falls at once; its C_mt (E+ over a huge m g d) is small, not zero, and `walk` prints
+    it to four significant digits (it printed 0.000), with a note that the mass is far from Table I's."""
+    import json
+    import re
+
+    from drake_biped.cli import main
+
+    huge = _model_file(tmp_path, lambda t: t.replace('<mass value="6.646"/>', '<mass value="66460"/>', 1), "huge.urdf")
+    assert main(["walk", "--model", str(huge), "--no-animation", "--out", str(tmp_path / "w")]) == 0
+    out, err = capsys.readouterr()
+    r = json.loads((tmp_path / "w" / "result.json").read_text())
+    assert r["fell"] and r["distance_m"] < 0.5 and 0 < r["cost_of_transport"] < 1e-4
+    shown = float(re.search(r"C_mt (\d+\.\d+) \(E\+/\(m g d\)\)", out).group(1))
+    assert shown == pytest.approx(r["cost_of_transport"], rel=1e-3)
+    notes = [line for line in err.splitlines() if line.startswith("note:")]
+    assert len(notes) == 1 and "total mass is 66463.6 kg" in notes[0] and "Table I's 10.202 kg" in notes[0]
 
 
 def _hips_effort(value: str | None):
@@ -513,6 +533,36 @@ def test_a_mesh_named_relative_to_the_model_file_resolves(tmp_path):
     model = RobotModel.from_file(_model_file(tmp_path, edit))
     assert model.directory == str(tmp_path.resolve())
     add_biped(DiagramBuilder(), Ground(), 1e-3, model)  # no ModelError: the relative file name resolved
+
+
+def test_a_models_file_is_found_or_named_with_where_it_was_looked_for(tmp_path):
+    """A mesh named by an absolute path resolves; a missing one, relative or absolute, and a package nobody
+    declared are ModelError naming the file and where it was looked for, through the API as on the command line."""
+    from drake_biped.episode import run_episode
+    from drake_biped.params import EpisodeConfig, RobotModel
+
+    (tmp_path / "box.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+
+    def with_mesh(uri, name):
+        visual = f'<visual><geometry><mesh filename="{uri}"/></geometry></visual>'
+        return RobotModel.from_file(_model_file(tmp_path, lambda t: t.replace('<link name="torso">',
+                                                                              f'<link name="torso">{visual}', 1), name))
+
+    build_plant(model=with_mesh(str(tmp_path / "box.obj"), "absolute.urdf"))  # no ModelError: it resolved
+    folder = tmp_path.resolve()
+    cases = [("meshes/nope.obj", f"looked for {folder / 'meshes' / 'nope.obj'} (in the model file's folder)"),
+             (str(tmp_path / "nope.obj"), f"looked for {tmp_path / 'nope.obj'}"),
+             ("package://nopkg/box.obj", f"in the package 'nopkg', which is unknown: the model file's folder {folder} "
+                                         "has no package.xml")]
+    for uri, where in cases:
+        model = with_mesh(uri, "mine.urdf")
+        with pytest.raises(ModelError) as raised:
+            run_episode(EpisodeConfig(model=model))
+        assert f"the model mine.urdf names the file {uri!r}" in str(raised.value)
+        assert where in str(raised.value) and "\n" not in str(raised.value)
+    text = with_mesh("box.obj", "mine.urdf").text  # a relative name without the folder to read it against
+    with pytest.raises(ModelError, match="relative to the model file, but the model was given as text"):
+        build_plant(model=RobotModel("mine.urdf", text))
 
 
 def test_an_sdformat_model_of_the_shipped_robot_walks_as_the_urdf(tmp_path):

@@ -108,32 +108,32 @@ def test_a_window_map_beyond_its_limit_is_refused_before_any_work(tmp_path, caps
     assert not (tmp_path / "m").exists()
 
 
-def test_a_window_map_keeps_every_finished_episode_and_reads_them_back(tmp_path, client):
-    """Each finished row is appended as it comes: a map run again over a kept file runs only what is missing,
-    and a torn last line is run again."""
-    from drake_biped.experiments import window_map
+def test_a_window_map_keeps_every_finished_episode_and_sets_a_damaged_log_aside(tmp_path, client, capsys):
+    """Each finished row is appended to episodes.jsonl as it comes and read back by a rerun, which runs nothing
+    again. A damaged line and a torn last line: the file is set aside as episodes.jsonl.broken, as it was, with
+    one warning naming the lines (as docs/CLI.md says); the rows that read carry over, the two lost episodes
+    run again, and the map is the same."""
+    from drake_biped.experiments.window_map import WindowMapSettings, run
 
-    config = EpisodeConfig().override({"sim.distance_m": 0.3})
-    keep = tmp_path / "episodes.jsonl"
-    windows = [(0.1, 0.3), (0.2, 0.4)]
-    baseline, rows = window_map.evaluate_windows(config, windows, client, progress=False, keep=keep)
+    settings = WindowMapSettings(EpisodeConfig().override({"sim.distance_m": 0.3}), t1_max_s=0.1, t2_max_s=0.3)
+    out = tmp_path / "wm"
+    first = run(settings, out, client, progress=False)
+    keep = out / "episodes.jsonl"
     lines = keep.read_text().splitlines()
-    assert len(lines) == 3
-    keep.write_text("\n".join(lines[:2]) + "\n" + lines[2][:25])  # the last one torn by a kill
-    calls = []
-    real = window_map.window_row
-
-    def counting(c):
-        calls.append(c)
-        return real(c)
-
-    window_map.window_row = counting
-    try:
-        again = window_map.evaluate_windows(config, windows, client, progress=False, keep=keep)
-    finally:
-        window_map.window_row = real
-    assert again == (baseline, rows)
-    assert len(keep.read_text().splitlines()) == 4
+    assert len(lines) == 6 and len(first["windows"]) == 5
+    capsys.readouterr()
+    run(settings, out, client, progress=False)
+    assert keep.read_text().splitlines() == lines and capsys.readouterr().err == ""  # nothing run again
+    damaged = "\n".join([lines[0], '{"config": {"cpg"', *lines[2:5]]) + "\n" + lines[5][:25]
+    keep.write_text(damaged)
+    again = run(settings, out, client, progress=False)
+    err = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(err) == 1 and f"{keep} has 2 line(s) that do not read as a window-map episode (line 2, 6" in err[0]
+    assert err[0].endswith("kept as episodes.jsonl.broken")
+    assert (out / "episodes.jsonl.broken").read_text() == damaged
+    assert (again["baseline"], again["windows"]) == (first["baseline"], first["windows"])
+    now = keep.read_text().splitlines()
+    assert now[:4] == [lines[0], *lines[2:5]] and sorted(now) == sorted(lines)  # 4 carried over, 2 run again
 
 
 def test_a_scheduler_without_workers_is_said_within_seconds(monkeypatch):

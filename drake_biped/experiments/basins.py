@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.attractor import step_period_label
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import TRANSIENT_M
 from drake_biped.experiments.bifurcation import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
 from drake_biped.experiments.options import (
@@ -129,7 +130,7 @@ def markdown(record: dict[str, Any]) -> str:
             costs = [c["cost_of_transport"] for c in group if c["cost_of_transport"] is not None]
             lines.append(f"| {condition} | {kind} | {len(group)} | "
                          + (f"{min(periods):.3f}–{max(periods):.3f}" if periods else "—") + " | "
-                         + (f"{min(costs):.3f}–{max(costs):.3f}" if costs else "—") + " |")
+                         + (f"{format_cost(min(costs))}–{format_cost(max(costs))}" if costs else "—") + " |")
     return "\n".join(lines) + "\n"
 
 

@@ -34,6 +34,7 @@ from drake_biped.analysis.attractor import (
     lyapunov_from_neighbours,
     step_period_label,
 )
+from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.analysis.long_run import TRANSIENT_M, long_run_cost
 from drake_biped.experiments.options import (
     EPISODE_RECORD_BYTES,
@@ -262,7 +263,8 @@ def markdown(record: dict[str, Any]) -> str:
             cmt = "—"
         else:
             lo, hi = p["interval_95"] or (None, None)
-            cmt = f"{p['cost_of_transport']:.4f}" + (f" ± {0.5 * (hi - lo):.4f}" if lo is not None else "")
+            cmt = (format_cost_interval(p["cost_of_transport"], 0.5 * (hi - lo)) if lo is not None
+                   else format_cost(p["cost_of_transport"]))
         lines.append(f"| {p['value']:g} | {1e3 * p['time_step_s']:g} | {p['attractor']} | "
                      f"{p['within_jitter']['attractor']} | {span} | {exponent} | {cmt} |")
     up_to = record.get("walked_up_to")

@@ -17,8 +17,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.learner_comparison import RUNNING, best_walking_window, compare
-from drake_biped.analysis.series import signed_percent
+from drake_biped.analysis.series import cmt_change
 from drake_biped.experiments.options import (
     add_episode_options,
     add_resumable_run_options,
@@ -144,10 +145,10 @@ def _cell(value, fmt: str) -> str:
 
 
 def _rewalked(row: dict[str, Any]) -> str:
-    """The learner's re-walked reduction with its spread and the trials holding (`rewalks`)."""
+    """The learner's re-walked C_mt change with its spread and the trials holding (`rewalks`)."""
     if row.get("rewalked_saving") is None:
         return "—"
-    return (f"{signed_percent(row['rewalked_saving'])} ± {100 * row['rewalked_saving_std']:.1f} % "
+    return (f"{cmt_change(row['rewalked_saving'])} ± {100 * row['rewalked_saving_std']:.1f} % "
             f"({row['rewalked_holding']}/{row['trials']})")
 
 
@@ -161,16 +162,18 @@ def markdown(record: dict[str, Any]) -> str:
     best = record["best_window"]
     s = record["settings"]
     head = ("No window of the map walks" if best is None else
-            f"Best walking window of the map: ({best['t1']:g}, {best['t2']:g}) s, C_mt {best['cost_of_transport']:.4f}")
-    lines = [f"{head} (no window {_cell(record['no_window_cost_of_transport'], '.4f')}); {s['trials']} trials × "
+            f"Best walking window of the map: ({best['t1']:g}, {best['t2']:g}) s, C_mt {format_cost(best['cost_of_transport'])}")
+    lines = [f"{head} (no window {format_cost(record['no_window_cost_of_transport'], '—')}); {s['trials']} trials × "
              f"{s['episodes']} episodes from ({s['mean'][0]:g}, {s['mean'][1]:g}), variance {s['variance']:g} s².", "",
-             "| learner | final C_mt | reduction | re-walked reduction (trials holding ≥ 35 %) | final means that "
+             "C_mt change against no window (−: C_mt fell, a saving); a trial holds when it saves ≥ 35 % in "
+             "every re-walk.", "",
+             "| learner | final C_mt | C_mt change | re-walked C_mt change (trials holding) | final means that "
              "walk | distance to best (s) | trials within 5 % (episode) | falls | wall (min) |",
              "|---|---:|---:|---:|---:|---:|---|---:|---:|"]
     for name, r in record["learners"].items():
         reach = ", ".join("—" if e is None else str(e) for e in r["episodes_to_within"])
-        lines.append(f"| {name} | {_cell(r['final_cost_of_transport'], '.4f')} | "
-                     f"{_cell(None if r['reduction'] is None else 100 * r['reduction'], '+.1f')} % | "
+        lines.append(f"| {name} | {format_cost(r['final_cost_of_transport'], '—')} | "
+                     f"{cmt_change(r['reduction'])} | "
                      f"{_rewalked(r)} | {r['learned_walks']}/{r['trials']} | {_cell(r['mean_distance_to_best_s'], '.3f')} | "
                      f"{r['reached']}/{r['trials']} ({reach}) | {r['falls']}/{r['episodes']} | {_wall(r)} |")
     return "\n".join(lines) + "\n"

@@ -17,7 +17,8 @@ Which parameters mutate: "default" (MUTATIONS, the CPG's u_a, u_r, kappa among t
 CPG and the printed initiation held at what the start configuration has)
 or "near_paper" (those and the CPG's u_a, u_r, kappa) or "coast" (MUTATIONS, the knee's hold torque, the
 torso's gains and the stance knee).
-Every generation is appended to `search.jsonl`; a rerun resumes from its last line. The children of a
+Every generation is appended to `search.jsonl`; a rerun resumes from its last line (a damaged log is set aside
+as search.jsonl.broken and resumed from its last readable generation before the damage). The children of a
 generation are scored in parallel on Dask (`executor`).
 """
 
@@ -52,7 +53,7 @@ from drake_biped.params import (
     check_settings,
     walked_the_distance,
 )
-from drake_biped.records import write_text_atomic
+from drake_biped.records import read_kept_lines, write_text_atomic
 from drake_biped.versions import versions
 
 ACCEPTANCE_WINDOWS = ((0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7))
@@ -912,19 +913,10 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
 
 
 def _read_log(path: Path) -> list[dict]:
-    """The finished generations; a last line cut short by a kill is dropped (and rewritten away)."""
-    if not path.exists():
-        return []
-    records, lines = [], path.read_text().splitlines()
-    for i, line in enumerate(lines):
-        try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError as exc:
-            if i != len(lines) - 1:
-                raise ParameterError(f"{path}, line {i + 1}: not valid JSON ({exc}); only a last line cut short "
-                                     "by a kill is dropped: repair or delete that line to resume") from None
-            write_text_atomic(path, "".join(json.dumps(r) + "\n" for r in records))
-    return records
+    """The finished generations. Each builds on the one before: a line that does not read (a write cut short
+    by a kill, or damage) sets the log aside as search.jsonl.broken, with a warning, and the search resumes
+    after the last generation before it, as a search killed there would (records.read_kept_lines)."""
+    return read_kept_lines(path, "a gait-search generation", in_order=True)
 
 
 def _check_log(records: list[dict], settings: GaitSearchSettings, method: str, path: Path) -> None:

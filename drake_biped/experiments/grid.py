@@ -11,8 +11,9 @@ The best point walks furthest (to the centimetre); among points that go equally 
 It is written as a parameter file that every command accepts (`--params DIR/best_params.json`).
 
 Nothing lost: each finished point is appended to OUT/points.jsonl (and flushed) as it arrives; a rerun with
-the same base configuration reads them back and runs only the points missing. A truncated last line (a run
-killed while writing) is ignored and its point rerun.
+the same base configuration reads them back and runs only the points missing. A line that does not read (a run
+killed while writing, or damage) sets the file aside as points.jsonl.broken, with a warning, and its point runs
+again.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.experiments.options import (
     EPISODE_RECORD_BYTES,
     add_episode_options,
@@ -43,7 +45,7 @@ from drake_biped.experiments.options import (
 )
 from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
 from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError, check_settings, walked_the_distance
-from drake_biped.records import warn, write_atomic, write_text_atomic
+from drake_biped.records import read_kept_lines, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
 __all__ = ["MAX_GRID_POINTS", "Axis", "GridSettings", "check_size", "load_spec", "parse_spec", "point_count", "run",
@@ -228,20 +230,11 @@ def better(a: dict[str, Any], b: dict[str, Any] | None) -> bool:
 
 
 def read_points(path: Path) -> dict[str, dict[str, Any]]:
-    """Finished rows of OUT/points.jsonl by key. An unreadable line is skipped and its point computed again:
-    the last line silently (a write cut short by a kill), any other with a warning naming the line (the file
-    is kept as it is; the recomputed row is appended)."""
-    rows: dict[str, dict[str, Any]] = {}
-    if path.is_file():
-        lines = path.read_text().splitlines()
-        for k, line in enumerate(lines):
-            try:
-                row = json.loads(line)
-                rows[row["key"]] = row
-            except (json.JSONDecodeError, KeyError, TypeError):
-                if k != len(lines) - 1 and line.strip():
-                    warn(f"{path}, line {k + 1}: not a grid point record; its point is computed again")
-    return rows
+    """Finished rows of OUT/points.jsonl by key. A line that does not read (a write cut short by a kill, or
+    damage) sets the file aside as points.jsonl.broken with a warning naming the line; the rows that read carry
+    over and its point is computed again (records.read_kept_lines)."""
+    rows = read_kept_lines(path, "a grid point record", lambda r: isinstance(r, dict) and isinstance(r["key"], str))
+    return {row["key"]: row for row in rows}
 
 
 def run_grid(out: Path, base: EpisodeConfig, axes: list[Axis], client,
@@ -365,7 +358,7 @@ def run(settings: GridSettings, out: Path, client=None, progress: bool = True,
 def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     """The grid in two lines: how many points walk, and the best."""
     best = record["best"]
-    cmt = "n/a" if best["cost_of_transport"] is None else f"{best['cost_of_transport']:.3f}"
+    cmt = format_cost(best["cost_of_transport"])
     distance = record["base_config"]["sim"]["distance_m"]
     return [f"{record['walked_the_distance']}/{record['points']} points walk {distance:g} m; best "
             f"{', '.join(f'{k}={v:.4g}' for k, v in best['point'].items())}: {best['distance_m']:.2f} m, C_mt {cmt}",

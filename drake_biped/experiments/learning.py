@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import measure_text
 from drake_biped.analysis.rewalks import measured_cost
 from drake_biped.analysis.reward import reward
@@ -481,8 +482,8 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     lines = [(out / "table_v.md").read_text()]
     base = ev["no_window"]["cost_of_transport"]
     if ev.get("reduction") is not None:
-        lines.append(f"C_mt without a torque-free period {base:.3f}, with the learned ones "
-                     f"{ev['learned_mean_cost_of_transport']:.3f}: {saving_words(ev['reduction'])}")
+        lines.append(f"C_mt without a torque-free period {format_cost(base)}, with the learned ones "
+                     f"{format_cost(ev['learned_mean_cost_of_transport'])}: {saving_words(ev['reduction'])}")
     run_log = read_json(out / "run.json", "learn")
     this = run_log["sessions"][-1]
     if this["episodes_per_min"]:

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.rewalks import CHANGE_WORDS, CHANGES
 from drake_biped.analysis.series import moving_average, period
 from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
@@ -224,7 +225,7 @@ def report_markdown(record: dict[str, Any]) -> str:
 
     def episode(r: dict[str, Any]) -> str:
         how = "climbs" if r["climbs"] else (f"falls ({r['fall_reason']})" if r["fell"] else "stops")
-        cmt = "" if r["cost_of_transport"] is None else f", C_mt {r['cost_of_transport']:.3f}"
+        cmt = "" if r["cost_of_transport"] is None else f", C_mt {format_cost(r['cost_of_transport'])}"
         return f"{how}: {r['distance_m']:.2f} m in {r['duration_s']:.1f} s{cmt}"
 
     def again(rows: dict[str, Any]) -> str:

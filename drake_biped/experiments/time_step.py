@@ -24,6 +24,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, has_long_run, long_run_of_record
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.executor import episode_task, map_ordered
@@ -213,7 +214,7 @@ def markdown(rec: dict) -> str:
         noise = r.get("deviation_noise") or 0.0
         mark = ("" if dev is None or abs(dev) <= rec["tolerance"]
                 else " ≈" if abs(dev) <= noise else " ✗")
-        text = f"{r['cost_of_transport']:.4f} ± {r['half_width']:.4f}"
+        text = format_cost_interval(r["cost_of_transport"], r["half_width"])
         return f"{text} ({signed_percent(dev)}){mark}" if dev is not None else text
 
     chosen = rec["chosen_step_s"]
@@ -267,7 +268,7 @@ def markdown(rec: dict) -> str:
         "",
         "## The episode's C_mt (whole walk, initiation included)",
         "",
-        *table(lambda r: f"{r['episode_cost_of_transport']:.4f}" if r.get("episode_cost_of_transport") else "—"),
+        *table(lambda r: format_cost(r.get("episode_cost_of_transport") or None, "—")),
         "",
         "## Step period after the transient (mean ± standard deviation, s)",
         "",

@@ -15,6 +15,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
+from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.experiments.options import (
     add_episode_options,
     episode_config,
@@ -23,6 +24,7 @@ from drake_biped.experiments.options import (
     print_lines,
 )
 from drake_biped.params import (
+    TOTAL_MASS_KG,
     EpisodeConfig,
     ParameterError,
     Push,
@@ -163,8 +165,7 @@ def summary_lines(result) -> list[str]:
     """What `drake-biped walk` prints: how the walk ended, its gait, its energy, its speed of simulation."""
     status = ((f"DIVERGED ({result.fall_reason})" if result.termination == "diverged" else f"FELL ({result.fall_reason})")
               if result.fell else f"ended: {result.termination}")
-    cmt = "n/a" if result.cost_of_transport is None else f"{result.cost_of_transport:.3f}"
-    cmt_kg = "n/a" if result.cost_of_transport_per_kg is None else f"{result.cost_of_transport_per_kg:.3f}"
+    cmt, cmt_kg = format_cost(result.cost_of_transport), format_cost(result.cost_of_transport_per_kg)
     if result.step_period_s is None or result.step_length_m is None:  # they need three touchdowns
         gait = "too few for a step period and length (3 touchdowns needed)"
     else:
@@ -179,6 +180,24 @@ def summary_lines(result) -> list[str]:
     ]
 
 
+# A model whose total mass is more than this factor from Table I's (heavier or lighter) is noted after its walk:
+# C_mt = E+/(m g d) divides by the model's own mass while the motors' work changes little with it, so a C_mt far
+# from the shipped robot's is then the mass's doing (docs/MODEL.md, "A robot of your own").
+MASS_NOTE_FACTOR = 2.0
+
+
+def mass_note(mass_kg: float) -> str | None:
+    """The note `walk` prints on standard error when the model's total mass is more than MASS_NOTE_FACTOR from
+    Table I's (params.TOTAL_MASS_KG); None otherwise."""
+    ratio = mass_kg / TOTAL_MASS_KG
+    if 1.0 / MASS_NOTE_FACTOR <= ratio <= MASS_NOTE_FACTOR:
+        return None
+    times = f"{ratio:,.0f}" if ratio >= 100 else f"{ratio:.3g}"
+    return (f"note: the model's total mass is {mass_kg:.6g} kg, {times} x Table I's {TOTAL_MASS_KG:g} kg; C_mt = "
+            "E+/(m g d) divides by the model's own mass while the motors' work changes little with it "
+            "(docs/MODEL.md, 'A robot of your own')")
+
+
 def long_run_lines(result) -> list[str]:
     """The long-run line of a walk that went at least TRANSIENT_M + LONG_RUN_M (110 m) without falling: its C_mt
     after the initiation's transient, with the 95 % interval, and the kept steps' period; none for a shorter walk
@@ -190,7 +209,7 @@ def long_run_lines(result) -> list[str]:
     lr = result.long_run()
     if lr["cost_of_transport"] is None:
         return []
-    return [f"long-run C_mt {lr['cost_of_transport']:.4f} ± {lr['half_width']:.4f} (95 %) over the "
+    return [f"long-run C_mt {format_cost_interval(lr['cost_of_transport'], lr['half_width'])} (95 %) over the "
             f"{lr['distance_m']:.1f} m after the first {TRANSIENT_M:g} m ({lr['steps']} steps of "
             f"{lr['step_period_mean_s']:.3f} ± {lr['step_period_std_s']:.3f} s)"]
 
@@ -222,7 +241,7 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
         warn(str(exc))
     window = config.window
     title = (
-        f"C_mt {result.cost_of_transport:.3f}" if result.cost_of_transport is not None else "C_mt n/a"
+        f"C_mt {format_cost(result.cost_of_transport)}"
     ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
     walk_figure(result.trajectory, out / "walk.png", title=title)
     if meshcat is not None:
@@ -280,6 +299,9 @@ def command(args: argparse.Namespace) -> int:
     out = Path(args.out)
     result = run(settings, out)
     print_lines(summary_lines(result))
+    note = mass_note(result.mass_kg)
+    if note is not None:
+        print(note, file=sys.stderr)
     if not args.no_animation:
         print_lines(animation_lines(out))
     if config.push is not None and result.duration_s <= config.push.start_s:

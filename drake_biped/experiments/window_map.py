@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.series import signed_percent
 from drake_biped.experiments.options import (
     add_cluster_options,
@@ -33,7 +34,7 @@ from drake_biped.params import (
     check_settings,
     walked_the_distance,
 )
-from drake_biped.records import write_text_atomic
+from drake_biped.records import read_kept_lines, write_text_atomic
 from drake_biped.versions import versions
 
 # The most windows a map runs without force=True (--force): every one an episode held in memory before the first.
@@ -159,18 +160,14 @@ def evaluate_windows(config: EpisodeConfig, windows: list[tuple[float, float]], 
 
 
 def _read_kept_rows(path: Path | None) -> dict[str, dict]:
-    """The rows kept in `path` by configuration (its sorted JSON); a torn last line (a kill mid-write) is
-    dropped."""
-    if path is None or not Path(path).is_file():
+    """The rows kept in `path` by configuration (its sorted JSON). A line that does not read (a torn last line
+    of a kill mid-write, or damage) sets the file aside as episodes.jsonl.broken with a warning, and its episode
+    is run again (records.read_kept_lines)."""
+    if path is None:
         return {}
-    out = {}
-    for line in Path(path).read_text().splitlines():
-        try:
-            entry = json.loads(line)
-            out[json.dumps(entry["config"], sort_keys=True)] = entry["row"]
-        except (ValueError, KeyError, TypeError):
-            continue
-    return out
+    entries = read_kept_lines(path, "a window-map episode",
+                              lambda e: isinstance(e["config"], dict) and isinstance(e["row"], dict))
+    return {json.dumps(e["config"], sort_keys=True): e["row"] for e in entries}
 
 
 def run(settings: WindowMapSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
@@ -201,12 +198,11 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     baseline, rows = record["baseline"], record["windows"]
     walked = [r for r in rows if r["walked"]]
     best = min(walked, key=lambda r: r["cost_of_transport"], default=None)
-    cmt = "n/a" if baseline["cost_of_transport"] is None else f"{baseline['cost_of_transport']:.3f}"
-    lines = [f"no window: walked={baseline['walked']} C_mt={cmt}",
+    lines = [f"no window: walked={baseline['walked']} C_mt={format_cost(baseline['cost_of_transport'])}",
              f"{len(walked)}/{len(rows)} windows walk {record['config']['sim']['distance_m']:g} m"]
     if best is not None:
-        lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={best['cost_of_transport']:.3f} "
-                     f"({signed_percent(best['cmt_change'])} vs no window)")
+        lines.append(f"lowest C_mt: window ({best['t1']:g}, {best['t2']:g}) C_mt={format_cost(best['cost_of_transport'])} "
+                     f"(C_mt change {signed_percent(best['cmt_change'])} vs no window)")
     return lines
 
 
