@@ -617,6 +617,9 @@ class EpisodeConfig(_Validated):
         super().__post_init__()
         if self.seed < 0:
             raise ParameterError(f"EpisodeConfig.seed must be a non-negative integer, got {self.seed!r}")
+        if self.push is not None and self.push.force_n != 0.0 and self.push.duration_s == 0.0:
+            raise ParameterError(f"Push.duration_s = 0.0 with force_n {self.push.force_n!r}: the push would never "
+                                 "act; give a duration, or no push")
         if self.push is not None and self.push.force_n != 0.0 and self.push.start_s >= self.sim.max_time_s:
             raise ParameterError(f"Push.start_s = {self.push.start_s!r} is at or after the time limit "
                                  f"sim.max_time_s = {self.sim.max_time_s!r}: the push would never act")

@@ -125,6 +125,8 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
       "--out", "{tmp}/b"], ["--second-time-step 0.001", "same result"]),
     (["grid", "--spec", "{file:spec_noop.yaml}", "--out", "{tmp}/g"], ["axis window.start_s", "changes nothing"]),
     (["walk", "--level-length", "2", "--out", "{tmp}/w"], ["--level-length 2", "changes nothing"]),
+    (["walk", "--push", "0", "--out", "{tmp}/w"], ["--push 0", "changes nothing"]),
+    (["walk", "--push", "20", "--push-duration", "0", "--out", "{tmp}/w"], ["--push-duration", "must be > 0"]),
 ]
 
 
@@ -310,6 +312,9 @@ def _api_cases():
          db.ParameterError, "needs touchdown 6"),
         (lambda: BifurcationSettings(param="t1", values=(0.2, 0.3)), db.ParameterError, "never opens"),
         (lambda: GridSettings(axes=(Axis("window.start_s", (0.1, 0.2)),)), db.ParameterError, "changes nothing"),
+        (lambda: db.EpisodeConfig(push=db.Push(20.0, duration_s=0.0)), db.ParameterError, "never act"),
+        (lambda: db.reward(float("nan"), 10.0, 10.0), ValueError, "NaN"),
+        (lambda: db.cost_of_transport(float("nan"), 10.0, 1.0), ValueError, "positive_work_j"),
     ]
 
 

@@ -223,9 +223,6 @@ def episode_config(args: argparse.Namespace) -> EpisodeConfig:
     if args.level_length is not None:
         changes["ground.level_length_m"] = args.level_length
     config = with_clock(config.override(changes), args.time_step, args.control_period)
-    if args.level_length is not None and config.ground.slope_rad == 0.0:
-        raise ParameterError(f"--level-length {args.level_length:g}: the ground is level (no --slope), so a level "
-                             "stretch before it changes nothing; give --slope too")
     config = with_model(config, args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
         print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "

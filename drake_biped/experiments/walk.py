@@ -278,6 +278,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def settings_from_args(args: argparse.Namespace) -> WalkSettings:
     """The walk's settings from the command's options."""
     config = episode_config(args)
+    if args.level_length is not None and config.ground.slope_rad == 0.0:
+        raise ParameterError(f"--level-length {args.level_length:g}: the ground is level (no --slope), so a level "
+                             "stretch before it changes nothing; give --slope too")
+    if args.push is not None and args.push == 0.0:
+        raise ParameterError("--push 0: a push of no force changes nothing; give a force (N, + forward)")
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
     if args.t1 is not None:
