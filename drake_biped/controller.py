@@ -102,6 +102,9 @@ CONTROLLER_STATE = VectorLayout("controller_state", (
     Field("torque_reversals", 1, "updates at which a joint's torque jumped by more than REVERSAL_FACTOR times its "
                                  "motor's limit from the previous control period (a diverging control loop)"),
     Field("recent_reversals_s", 5, "the times of the last DIVERGED_REVERSALS reversals, latest first (-inf: none)"),
+    Field("motor_model_rate_radps", 1, "the hip motor's coordinate rate its model expects at this update, from the "
+                                       "last (NaN: none since the roles last swapped)"),
+    Field("motor_disturbance_radps", 1, "what that model missed at the last update: the rate measured minus it"),
 ))
 N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
@@ -114,6 +117,7 @@ Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
 POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_work_j"), _o("previous_clearance_m")
 PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_rates_radps"), _o("swing_travel_rad")
 REVERSALS, RECENT_REVERSALS = _o("torque_reversals"), _o("recent_reversals_s")
+MOTOR_MODEL_RATE, MOTOR_DISTURBANCE = _o("motor_model_rate_radps"), _o("motor_disturbance_radps")
 del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
@@ -153,6 +157,9 @@ REVERSAL_FACTOR = 1.5
 DIVERGED_REVERSALS = 5
 DIVERGENCE_SPAN_PERIODS = 20
 DIVERGED_CODE = 5
+# How much of what the hip motor's model missed at the last update it adds at the next (a low pass: an impact
+# that the model misses for one update does not set the motor ringing).
+MOTOR_DISTURBANCE_GAIN = 0.5
 
 
 def touchdown_capacity(config: EpisodeConfig) -> int:
@@ -183,6 +190,9 @@ LAW = VectorLayout("law", (
     Field("ground_slope_rad", 1, ""), Field("ground_tan_slope", 1, "tan of the slope"),
     Field("ground_level_length_m", 1, "level ground before the slope (NaN: the slope everywhere)"),
     Field("fall_hip_height_m", 1, ""), Field("fall_pitch_rad", 1, ""),
+    Field("hip_motor", 1, "1.0 for hip_drive 'motor' (zeta the hip joint's velocity, reached each update)"),
+    Field("inter_leg", 1, "1.0 for hip_joint 'inter_leg'"),
+    Field("motor_limit_nm", 1, "the hip motor's maximum torque (N*m)"),
 ))
 _o = LAW.offset
 L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("update_period_s", "state_lag_s", "alpha", "u_a",
@@ -198,7 +208,16 @@ L_ANKLE_KP, L_ANKLE_KD, L_TOUCHDOWN = _o("ankle_kp"), _o("ankle_kd"), _o("touchd
 L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_first_step")
 L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
 L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
+L_MOTOR, L_INTER_LEG, L_MOTOR_LIMIT = _o("hip_motor"), _o("inter_leg"), _o("motor_limit_nm")
 del _o
+
+# What the hip motor (GaitParams.hip_drive "motor") reads of the plant's dynamics at each update, computed by
+# `CpgWalkingController.motor_dynamics` from the state the update reads: the mass matrix M (9 x 9), the rows
+# of the constraints that hold (the stance foot's contact: heel x, heel z, toe z; each knee at its stop), up to
+# DYN_ROWS of 9, their number, and f = gravity - bias (9), row-major.
+DYN_ROWS = 5
+DYN_M, DYN_J, DYN_N, DYN_F = 0, 81, 81 + 9 * DYN_ROWS, 82 + 9 * DYN_ROWS
+DYN_SIZE = DYN_F + 9
 
 
 def law_vector(config: EpisodeConfig) -> np.ndarray:
@@ -233,6 +252,9 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     put("ground_level_length_m", math.nan if ground.level_length_m is None else ground.level_length_m)
     put("fall_hip_height_m", sim.fall_hip_height_m)
     put("fall_pitch_rad", sim.fall_pitch_rad)
+    put("hip_motor", 1.0 if g.hip_drive == "motor" else 0.0)
+    put("inter_leg", 1.0 if g.hip_joint == "inter_leg" else 0.0)
+    put("motor_limit_nm", g.motor_limit_nm)
     return v
 
 
@@ -292,7 +314,54 @@ def predicted_touchdown_k(law, s, now: float, clearance: float, c_prev: float, a
 
 
 @njit
-def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance: tuple, swing: tuple) -> None:
+def constrained_inverse_k(dyn) -> tuple:
+    """(P, b) from the plant's dynamics `dyn` (DYN_*): P = M^-1 - M^-1 Jc^T (Jc M^-1 Jc^T)^-1 Jc M^-1, the
+    generalized accelerations per unit generalized force with the constraints that hold (the stance foot held
+    by its contact, a knee at its stop), and b = P f, the accelerations of gravity and the velocity terms
+    alone."""
+    m = np.ascontiguousarray(dyn[DYN_M : DYN_M + 81]).reshape(9, 9)
+    rows = int(dyn[DYN_N])
+    jc = np.ascontiguousarray(dyn[DYN_J : DYN_J + 9 * rows]).reshape(rows, 9)
+    f = np.ascontiguousarray(dyn[DYN_F : DYN_F + 9])
+    mi = np.linalg.inv(m)
+    mi_jt = np.ascontiguousarray(mi @ jc.T)
+    k = mi_jt @ np.linalg.inv(jc @ mi_jt)
+    p = mi - k @ np.ascontiguousarray(mi_jt.T)
+    return p, p @ f
+
+
+@njit
+def motor_coordinate_k(law, v, sw_i: int, st_i: int) -> float:
+    """The rate the hip motor drives: the swing hip joint's, or the inter-leg angle's (swing minus stance)."""
+    return v[sw_i] - v[st_i] if law[L_INTER_LEG] != 0.0 else v[sw_i]
+
+
+@njit
+def motor_model_k(law, dyn, v, dt: float, sw_i: int, st_i: int, others, torso: float) -> tuple:
+    """(rate, gain, offset): the model's rate of the motor's coordinate (`motor_coordinate_k`) at the end of
+    the update is rate + gain * (swing hip torque - offset), given the other joints' torques `others` (9
+    generalized forces, the hips' zero) and the torso's torque law `torso` (the hips' summed torque): the
+    stance hip gives torso - swing hip torque (hip_joint "swing"); under "inter_leg" the hips' common mode holds
+    the torso and their difference mode (swing - offset, offset = torso / 2) drives the legs apart."""
+    p, b = constrained_inverse_k(dyn)
+    u = others.copy()
+    if law[L_INTER_LEG] != 0.0:
+        u[sw_i] += 0.5 * torso
+        u[st_i] += 0.5 * torso
+        rate = v[sw_i] - v[st_i] + dt * (b[sw_i] - b[st_i])
+        for j in range(9):
+            rate += dt * (p[sw_i, j] - p[st_i, j]) * u[j]
+        return rate, dt * (p[sw_i, sw_i] - p[sw_i, st_i] - p[st_i, sw_i] + p[st_i, st_i]), 0.5 * torso
+    u[st_i] += torso
+    rate = v[sw_i] + dt * b[sw_i]
+    for j in range(9):
+        rate += dt * p[sw_i, j] * u[j]
+    return rate, dt * (p[sw_i, sw_i] - p[sw_i, st_i]), 0.0
+
+
+@njit
+def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance: tuple, swing: tuple,
+                     dyn) -> None:
     """The six torques over the period [now, now + dt) for the given roles, into s[TAU:], advancing
     the CPG phase, the swing travel, the hip integrator and the gate in s."""
     dt = law[L_DT]
@@ -326,21 +395,8 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
     free = 0.0
     if s[STEP_COUNT] >= law[L_FIRST_STEP]:
         free = torque_free_fraction(elapsed, dt, law[L_T1], law[L_T2])
-    hip_limit = body[B_HIP_EFFORT]
-    if free >= 1.0:
-        tau_swing_hip = 0.0
-    else:
-        s[INTEGRAL] += angle_error * dt * (1.0 - free)
-        tau_swing_hip = (1.0 - free) * clip(
-            hip_servo_torque_k(law[L_HIP_KP], law[L_HIP_KD], law[L_HIP_KI], angle_error, zeta - swing_rate,
-                               s[INTEGRAL]), hip_limit)
     s[GATE] = free
-    tau_stance_hip = clip(torso_torque_k(law[L_TORSO_KP], law[L_TORSO_KD], law[L_TORSO_PITCH], pitch, pitch_rate)
-                          - tau_swing_hip, hip_limit)
-
     a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
-    s[a_sw] = tau_swing_hip
-    s[a_st] = tau_stance_hip
     # the swing knee's switches placed inside the period, along the state extrapolated over it
     knee = (law[L_KNEE], law[L_KNEE + 1], law[L_KNEE + 2], law[L_KNEE + 3], law[L_KNEE + 4], law[L_KNEE + 5],
             law[L_KNEE + 6])
@@ -357,13 +413,41 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
         s[a + ANKLE] = clip(ankle_torque_k(law[L_ANKLE_KP], law[L_ANKLE_KD], leg[_FOOT], foot_rate, slope),
                             ankle_limit)
 
+    # The hips: the swing hip drives the swing (servo or motor), gated; the stance hip holds the torso.
+    hip_limit = body[B_HIP_EFFORT]
+    torso = torso_torque_k(law[L_TORSO_KP], law[L_TORSO_KD], law[L_TORSO_PITCH], pitch, pitch_rate)
+    if law[L_MOTOR] != 0.0:
+        # ODE's motor: the torque that brings the coordinate's rate to zeta by the update's end, from the
+        # plant's dynamics and what the last update's model missed (the disturbance: the joint limits' and the
+        # other contacts' forces, the contact's compliance), clipped to the motor's limit; the model's rate of
+        # the torque applied is kept for the next update to measure the disturbance by.
+        others = np.zeros(9)
+        for i in range(6):
+            if i % 3 != 0:  # knees and ankles, set above
+                others[3 + i] = s[TAU + i]
+        rate, gain, offset = motor_model_k(law, dyn, v, dt, sw_i, st_i, others, torso)
+        drive = 0.0
+        if gain > 0.0:
+            drive = clip((zeta - rate - s[MOTOR_DISTURBANCE]) / gain, law[L_MOTOR_LIMIT])
+        tau_swing_hip = 0.0 if free >= 1.0 else (1.0 - free) * clip(offset + drive, hip_limit)
+        s[MOTOR_MODEL_RATE] = rate + gain * (tau_swing_hip - offset)
+    elif free >= 1.0:
+        tau_swing_hip = 0.0
+    else:
+        s[INTEGRAL] += angle_error * dt * (1.0 - free)
+        tau_swing_hip = (1.0 - free) * clip(
+            hip_servo_torque_k(law[L_HIP_KP], law[L_HIP_KD], law[L_HIP_KI], angle_error, zeta - swing_rate,
+                               s[INTEGRAL]), hip_limit)
+    s[a_sw] = tau_swing_hip
+    s[a_st] = clip(torso - tau_swing_hip, hip_limit)
+
 
 @njit
-def control_step(law, body, t: float, x, s, tau, row) -> int:
+def control_step(law, body, t: float, x, s, tau, row, dyn) -> int:
     """One control update at context time t: reads the plant state x (q, v), advances the controller state
     s (CONTROLLER_STATE) in place and writes the torques for the coming period into tau (6). Returns a
     code of TOUCHED (a touchdown was confirmed: `row` holds its index and its TOUCHDOWN fields), FELL and
-    DONE_BIT."""
+    DONE_BIT. `dyn`: the plant's dynamics at x (DYN_*) where the hip is a motor, else unread."""
     dt = law[L_DT]
     now = t + law[L_LAG]  # the time of the plant state read (see "Timing")
     s[STATE_TIME] = now
@@ -403,6 +487,9 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     # entrained phase reading, where the phase swaps the roles and a touchdown only marks T_n.
     contact_right = s[CONTACT_RIGHT] > 0.5
     cst_i, csw_i, c_stance, c_swing = legs_k(contact_right, left, right)
+    if law[L_MOTOR] != 0.0 and s[MOTOR_MODEL_RATE] == s[MOTOR_MODEL_RATE]:  # the motor's model, measured
+        missed = motor_coordinate_k(law, v, sw_i, st_i) - s[MOTOR_MODEL_RATE]
+        s[MOTOR_DISTURBANCE] += MOTOR_DISTURBANCE_GAIN * (missed - s[MOTOR_DISTURBANCE])
     com_x = center_of_mass_k(body, px, pz, pitch, left, right)[0]
     s[COM_X] = com_x
 
@@ -464,6 +551,8 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
             s[GAMMA] = advance_phase_k(law[L_UR], law[L_KAPPA], 0.0, v[st_i + ANKLE], back)  # the phase since T_n
             s[INTEGRAL] = 0.0
             s[TRAVEL] = back * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.5 * s[GAMMA])
+            s[MOTOR_MODEL_RATE] = math.nan  # the motor drives the other legs' coordinate from here
+            s[MOTOR_DISTURBANCE] = 0.0
 
     # A touchdown predicted inside the coming period (the clearance extrapolated over it crosses the
     # touchdown height) swaps the roles at its own time: the period's torques blend the present roles'
@@ -492,8 +581,9 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
         new[GAMMA] = -swap * dt * phase_rate_k(law[L_UR], law[L_KAPPA], v[sw_i + ANKLE])
         new[TRAVEL] = -swap * dt * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.0)
         new[INTEGRAL] = 0.0
-        period_torques_k(law, body, new, q, v, now, not stance_right, swing, stance)
-    period_torques_k(law, body, s, q, v, now, stance_right, stance, swing)
+        new[MOTOR_DISTURBANCE] = 0.0
+        period_torques_k(law, body, new, q, v, now, not stance_right, swing, stance, dyn)
+    period_torques_k(law, body, s, q, v, now, stance_right, stance, swing, dyn)
     if swap >= 0.0:
         for i in range(TAU, TAU + 6):
             s[i] = swap * s[i] + (1.0 - swap) * new[i]
@@ -533,14 +623,56 @@ def control_step(law, body, t: float, x, s, tau, row) -> int:
     return code
 
 
+KNEE_STOP_RAD = 1e-3  # a knee within this of full extension (its stop, params.KNEE_LIMIT_RAD[0] = 0) is at it
+
+
+class _PlantDynamics:
+    """The plant's dynamics at a state, as the hip motor reads them (DYN_*), through a context of the plant's
+    own: the mass matrix, the stance foot's contact rows (its heel's x and z, its toe's z, at the soles'
+    lowest points) and gravity minus the bias term."""
+
+    def __init__(self, plant, body: np.ndarray):
+        from pydrake.multibody.tree import JacobianWrtVariable
+
+        from drake_biped.kinematics import B_HEEL_SOLE, B_HEEL_X, B_TOE_SOLE, B_TOE_X
+
+        self._plant = plant
+        self._context = plant.CreateDefaultContext()
+        self._feet = {right: plant.GetBodyByName(f"{'right' if right else 'left'}_foot").body_frame()
+                      for right in (False, True)}
+        self._points = np.array([[body[B_HEEL_X], 0.0, body[B_HEEL_SOLE]], [body[B_TOE_X], 0.0, body[B_TOE_SOLE]]]).T
+        self._kv = JacobianWrtVariable.kV
+        self._knees = [3 + joint_index(leg, "knee") for leg in LEGS]
+
+    def fill(self, dyn: np.ndarray, x: np.ndarray, stance_right: bool, torques: np.ndarray) -> None:
+        plant, context = self._plant, self._context
+        plant.SetPositionsAndVelocities(context, x)
+        dyn[DYN_M : DYN_M + 81] = plant.CalcMassMatrix(context).ravel()
+        world = plant.world_frame()
+        jac = plant.CalcJacobianTranslationalVelocity(context, self._kv, self._feet[stance_right], self._points,
+                                                      world, world)
+        dyn[DYN_J : DYN_J + 27] = jac[[0, 2, 5]].ravel()  # heel x, heel z, toe z
+        rows = 3
+        for k in self._knees:  # a knee at its stop with an extending torque held holds there
+            if x[k] <= KNEE_STOP_RAD and torques[k - 3] < 0.0:
+                dyn[DYN_J + 9 * rows : DYN_J + 9 * rows + 9] = 0.0
+                dyn[DYN_J + 9 * rows + k] = 1.0
+                rows += 1
+        dyn[DYN_N] = rows
+        dyn[DYN_F : DYN_F + 9] = plant.CalcGravityGeneralizedForces(context) - plant.CalcBiasTerm(context)
+
+
 class CpgWalkingController(LeafSystem):
     """CPG + torque-free gate + hip PID + knee/ankle/stance logic for the 7-link biped."""
 
     def __init__(self, config: EpisodeConfig, initial_stance_right: bool, initial_liftoff_angle: float,
-                 body: np.ndarray = TABLE_I_BODY):
+                 body: np.ndarray = TABLE_I_BODY, plant=None):
         """`body`: the model's body (kinematics.BODY, `model.body_of`), for the legs' points and the centre of
-        mass."""
+        mass. `plant`: the diagram's MultibodyPlant, whose dynamics the hip motor (GaitParams.hip_drive
+        "motor") reads at each update through a context of its own (None: no motor)."""
         super().__init__()
+        self._dyn = np.zeros(DYN_SIZE)
+        self._dynamics = None if plant is None else _PlantDynamics(plant, body)
         body = np.asarray(body, dtype=float)
         if body.shape != (BODY.size,):
             raise ValueError(f"body: expected a kinematics.BODY vector of {BODY.size}, got shape {body.shape}")
@@ -563,6 +695,7 @@ class CpgWalkingController(LeafSystem):
         initial[PREV_CLEARANCE] = math.inf
         initial[PREV_RATES : PREV_RATES + 2] = math.nan
         initial[RECENT_REVERSALS : RECENT_REVERSALS + DIVERGED_REVERSALS] = -math.inf
+        initial[MOTOR_MODEL_RATE] = math.nan
         self._torque_group = self.DeclareDiscreteState(6)
         self._state_group = self.DeclareDiscreteState(BasicVector(initial))
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
@@ -665,12 +798,24 @@ class CpgWalkingController(LeafSystem):
         rows = context.get_discrete_state(self._touchdown_group).value()[: n * _TD]
         return rows.reshape(n, _TD).copy()
 
+    def motor_dynamics(self, law: np.ndarray, x: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """The `dyn` argument of `control_step` for the plant state x and controller state s: the plant's
+        dynamics where the law's hip is a motor (`_PlantDynamics`), else the unread zeros."""
+        if law[L_MOTOR] == 0.0:
+            return self._dyn
+        if self._dynamics is None:
+            raise ValueError("hip_drive 'motor' needs the plant: build the controller with plant=")
+        self._dynamics.fill(self._dyn, x, s[STANCE_RIGHT] > 0.5, s[TAU : TAU + 6])
+        return self._dyn
+
     def _update(self, context, discrete_state):
         # The discrete state handed to the update holds the current values; the kernel advances the
         # controller state and the held torques in place.
-        code = control_step(self.law(context), self._body, context.get_time(), self._plant_state.Eval(context),
-                            discrete_state.get_mutable_value(self._state_group),
-                            discrete_state.get_mutable_value(self._torque_group), self._row)
+        law, x = self.law(context), self._plant_state.Eval(context)
+        s = discrete_state.get_mutable_value(self._state_group)
+        code = control_step(law, self._body, context.get_time(), x, s,
+                            discrete_state.get_mutable_value(self._torque_group), self._row,
+                            self.motor_dynamics(law, x, s))
         if code == 0:
             return None
         if code & TOUCHED:

@@ -315,6 +315,8 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     tau = ctrl_ctx.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
     touchdowns = ctrl_ctx.get_mutable_discrete_state(controller.touchdown_group).get_mutable_value()
     law, body, row = controller.kernel_arguments(ctrl_ctx)
+    motor = law[ctl.L_MOTOR] != 0.0  # the hip motor reads the plant's dynamics at each update
+    dyn = controller.motor_dynamics(law, x, s)
     store = controller.store_touchdown
     torques = controller.torque_group
     step = plant.ExecuteForcedEvents
@@ -337,7 +339,9 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
             set_time(t)
         step(plant_ctx, False)
         if k % every == 0:
-            code = ctl.control_step(law, body, t, x, s, tau, row)
+            if motor:
+                dyn = controller.motor_dynamics(law, x, s)
+            code = ctl.control_step(law, body, t, x, s, tau, row, dyn)
             mutable(torques)  # the held torques changed: what reads them is out of date
             if code:
                 if code & ctl.TOUCHED:

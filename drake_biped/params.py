@@ -197,6 +197,21 @@ class GaitParams(_Validated):
       not land last crossing the touchdown height) only marks T_n, which the torque-free window and the
       Poincare section count from; touchdown_min_phase is not used.
     Either swing reading applies within each half-cycle.
+
+    `hip_drive` says what realizes zeta at the hip:
+    - "servo": a PID servo of the swing thigh's world angle to the swing reading's reference (hip_kp, hip_kd,
+      hip_ki), its torque clipped to the motor's limit: ours, a soft explicit servo;
+    - "motor": the paper's words, "the desired Hip angular velocity ... realized by the internal PID controller
+      of the ODE": zeta is the desired angular velocity of the hip *joint* (`hip_joint`), reached within each
+      control update as ODE's joint motor reaches it (a velocity constraint bounded by a maximum torque). The
+      torque is the one that brings the joint's velocity to zeta at the update's end, computed from the
+      plant's dynamics (mass matrix, bias and gravity, the stance foot held by its contact, the other joints'
+      torques of the same update), clipped to `motor_limit_nm`. The swing reading's angle reference is not
+      used (ODE's motor has no angle feedback).
+    `hip_joint` (motor only): "swing", the swing hip joint, the torso balanced by the stance hip as under the
+    servo; or "inter_leg", the one inter-leg angle (swing hip minus stance hip, eq. 15's theta^Hip) driven by the
+    hips' differential mode, the torso by their common mode. Inside the torque-free window the swing hip's
+    torque is exactly zero under every drive.
     """
 
     # How zeta drives the swing (above): "anchored" or "integrated".
@@ -208,6 +223,10 @@ class GaitParams(_Validated):
     # period's torques blend the two roles' by the part of it each holds); "update", from the update that
     # detects the crossing (up to one period late).
     swap_timing: str = "predicted"
+    # What realizes zeta at the hip (above): "servo" or "motor"; the motor's joint and maximum torque (N*m).
+    hip_drive: str = "servo"
+    hip_joint: str = "swing"
+    motor_limit_nm: float = 40.0
     # Integrated reading: a constant offset of the swing reference at the end of the half-cycle (rad).
     swing_offset_rad: float = 0.0
     # Swing hip: PID servo of the swing thigh's world angle to the CPG reference (angle, zeta).
@@ -274,11 +293,14 @@ class GaitParams(_Validated):
         "touchdown_min_advance_m": (-0.5, 0.5),
         "touchdown_min_phase": (0.0, math.pi),
         "swing_offset_rad": (-1.5, 1.5),
+        "motor_limit_nm": (0.0, 200.0),
     }
 
     SWING_READINGS = ("anchored", "integrated")
     SWAP_TIMINGS = ("predicted", "update")
     PHASE_READINGS = ("reset", "entrained")
+    HIP_DRIVES = ("servo", "motor")
+    HIP_JOINTS = ("swing", "inter_leg")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -291,6 +313,12 @@ class GaitParams(_Validated):
         if self.swap_timing not in self.SWAP_TIMINGS:
             raise ParameterError(f"GaitParams.swap_timing = {self.swap_timing!r} is not one of "
                                  f"{list(self.SWAP_TIMINGS)}")
+        for name, allowed in (("hip_drive", self.HIP_DRIVES), ("hip_joint", self.HIP_JOINTS)):
+            if getattr(self, name) not in allowed:
+                raise ParameterError(f"GaitParams.{name} = {getattr(self, name)!r} is not one of {list(allowed)}")
+        if self.hip_drive == "servo" and self.hip_joint != "swing":
+            raise ParameterError(f"GaitParams.hip_joint = {self.hip_joint!r} reads the motor's joint: it changes "
+                                 "nothing under hip_drive 'servo'")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,104 @@
+"""The hip as ODE's joint motor (GaitParams.hip_drive "motor"): zeta is the hip joint's (or the inter-leg
+angle's) desired velocity, reached within each control update while the torque is under the motor's limit; the
+torque-free gate still gives exactly zero; the work counted is that of the torque the plant applied."""
+
+import numpy as np
+import pytest
+
+import drake_biped.controller as ctl
+from drake_biped.cpg import output
+from drake_biped.diagram import build_diagram
+from drake_biped.episode import reset_context, run_episode
+from drake_biped.kinematics import B_HIP_EFFORT
+from drake_biped.params import EpisodeConfig, TorqueFreeWindow
+
+
+def _motor(joint: str, **changes) -> EpisodeConfig:
+    return EpisodeConfig().override({"gait.hip_drive": "motor", "gait.hip_joint": joint, "sim.distance_m": 10.0,
+                                     **changes})
+
+
+def _tracking(config: EpisodeConfig, seconds: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Step the plant and the compiled update as episode._step_directly does, and return, for each update whose
+    hip torques lie under their limits (the motor's, and both hips' own; roles that do not swap, outside any
+    window), the rate
+    the motor drives after the plant's next step and the zeta that update aimed at; and max |zeta|."""
+    from pydrake.systems.analysis import Simulator
+
+    parts = build_diagram(config)
+    simulator = Simulator(parts.diagram)
+    reset_context(parts, simulator, config)
+    root = simulator.get_mutable_context()
+    plant, controller = parts.plant, parts.controller
+    pc, cc = plant.GetMyMutableContextFromRoot(root), controller.GetMyMutableContextFromRoot(root)
+    x = pc.get_discrete_state(0).get_value()
+    s = cc.get_mutable_discrete_state(controller.state_group).get_mutable_value()
+    tau = cc.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
+    law, body, row = controller.kernel_arguments(cc)
+    inter = config.gait.hip_joint == "inter_leg"
+    hip = body[B_HIP_EFFORT]
+    h, pending, rates, aims, top = config.sim.time_step_s, None, [], [], 0.0
+    for k in range(int(seconds / h)):
+        plant.ExecuteForcedEvents(pc, False)
+        v = x[9:]
+        if pending is not None:
+            sw, st, zeta = pending
+            rates.append(v[sw] - v[st] if inter else v[sw])
+            aims.append(zeta)
+        stance_right = s[ctl.STANCE_RIGHT] > 0.5
+        code = ctl.control_step(law, body, k * h, x, s, tau, row, controller.motor_dynamics(law, x, s))
+        cc.get_mutable_discrete_state(controller.torque_group)
+        sw, st = (ctl.Q_HIP_LEFT, ctl.Q_HIP_RIGHT) if s[ctl.STANCE_RIGHT] > 0.5 else (ctl.Q_HIP_RIGHT, ctl.Q_HIP_LEFT)
+        zeta = output(config.cpg, s[ctl.GAMMA])
+        top = max(top, abs(zeta))
+        drive = tau[sw - 3] - (0.5 * (tau[sw - 3] + tau[st - 3]) if inter else 0.0)
+        free = (stance_right != (s[ctl.STANCE_RIGHT] > 0.5)) or s[ctl.GATE] > 0.0
+        limited = abs(drive) >= 0.99 * config.gait.motor_limit_nm or max(abs(tau[sw - 3]), abs(tau[st - 3])) >= 0.99 * hip
+        pending = None if free or limited else (sw, st, zeta)
+        if code & (ctl.FELL | ctl.DONE_BIT):
+            break
+    return np.array(rates), np.array(aims), top
+
+
+@pytest.mark.parametrize("joint", ["swing", "inter_leg"])
+def test_the_motor_brings_the_joints_velocity_to_zeta_within_the_update(joint):
+    """Under its limit the motor reaches the velocity zeta asks for by the end of each update, as ODE's motor
+    (a velocity constraint) does: within 1 % of max |zeta| at 95 % of the updates, the rest the one update after
+    an impact (a knee reaching its stop) that the motor's model sees only once it has happened."""
+    rates, aims, top = _tracking(_motor(joint), 0.4)
+    error = np.abs(rates - aims) / top
+    assert len(error) > 200
+    assert np.quantile(error, 0.95) <= 0.01, np.quantile(error, [0.5, 0.9, 0.95, 0.99])
+    assert np.median(error) <= 0.002
+
+
+@pytest.mark.parametrize("joint", ["swing", "inter_leg"])
+def test_inside_the_window_the_motors_torque_is_exactly_zero(joint):
+    config = _motor(joint).replace(window=TorqueFreeWindow(0.05, 0.15, first_step=0))
+    T = run_episode(config.override({"sim.distance_m": 0.5, "sim.max_time_s": 1.0}), record_trajectory=True,
+                    cache=None).trajectory
+    gated = T["torque_free"] == 1.0
+    swing_hip = np.where(T["stance_right"] > 0.5, T["actuation"][:, 0], T["actuation"][:, 3])
+    assert gated.sum() > 50
+    assert np.all(swing_hip[gated] == 0.0)
+    assert np.any(np.abs(swing_hip[~gated]) > 1.0)
+
+
+def test_the_work_counted_is_that_of_the_torque_the_plant_applied():
+    """The plant's own net actuation (its output port) is the torque the controller holds, and the positive work
+    counted equals that torque's work over the logged joint displacements, held over each update."""
+    from drake_biped.analysis.cost_of_transport import positive_work
+    from drake_biped.episode import simulate
+
+    config = _motor("swing", **{"sim.distance_m": 0.5, "sim.max_time_s": 1.0})
+    parts, simulator, _, _ = simulate(config, record=True, cache=None)
+    root = simulator.get_context()
+    applied = parts.plant.get_net_actuation_output_port().Eval(parts.plant.GetMyContextFromRoot(root))
+    held = parts.actuation_log.FindLog(root).data()  # the controller's torques, one column per update
+    # the plant's output is sampled: what it applied over its last step, the torques the update before held
+    np.testing.assert_array_equal(applied, held[:, -2])
+    T = run_episode(config, record_trajectory=True, cache=None).trajectory
+    dt = float(np.diff(T["time"])[0])
+    offline = positive_work(T["actuation"][:-1], np.diff(T["positions"][:, 3:], axis=0) / dt, dt)
+    np.testing.assert_allclose(T["positive_work"][-1], offline, rtol=1e-9, atol=1e-9)
+    assert np.max(np.abs(T["actuation"][:, [0, 3]])) > 5.0  # the motor did work
