@@ -115,8 +115,19 @@ COAST_MUTATIONS = {
     ("gait", "torso_kd"): ("log", 0.1, 2.0, 500.0),
     ("gait", "stance_knee_torque"): ("log", 0.1, 1.0, 30.0),
 }
+# What the paper does not print when the hip is its ODE motor (GaitParams.hip_drive "motor"): the motor's torque
+# limit (up to the model's 40 N*m), the knees' torques and switches, the ankles' gains, the torso's law, the
+# touchdown's phase and the first swing's phase; the CPG (Table III) and the printed initiation held. The motor
+# is a velocity constraint (stiff by construction): its limit is its one parameter. The servo's gains and the
+# swing reference's placement terms do not act under the motor and are not searched.
+PAPER_MOTOR_MUTATIONS = {
+    ("gait", "motor_limit_nm"): ("log", 0.1, 5.0, 40.0),
+    **{k: v for k, v in PAPER_MUTATIONS.items()
+       if k[1] not in ("hip_kp", "hip_kd", "placement_gain", "placement_velocity_gain", "swing_offset_rad")},
+    ("gait", "knee_hold_torque"): ("add", 0.3, -2.0, 10.0),
+}
 MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
-                 "coast": COAST_MUTATIONS}
+                 "coast": COAST_MUTATIONS, "paper_motor": PAPER_MOTOR_MUTATIONS}
 # The "robust" objective's changes to the walk without a window, and the half step's allowed C_mt change.
 ROBUST_CHECKS = ("half_step", "speed_0.95", "speed_1.05", "push_forward", "push_backward")
 ROBUST_CMT_CHANGE = 0.02
@@ -959,11 +970,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--generations", type=count, default=50, help="generations")
     p.add_argument("--offspring", type=count, default=4, help="children per generation")
     p.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale")
-    p.add_argument("--mutations", choices=["default", "paper", "near_paper", "coast"], default="default",
+    p.add_argument("--mutations", choices=list(MUTATION_SETS), default="default",
                    help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
                    "the paper does not print: the CPG and the initiation held), 'near_paper' (those "
-                   "and u_a, u_r, kappa) or 'coast' (default, the knee's hold torque, the torso's "
-                   "gains and the stance knee)")
+                   "and u_a, u_r, kappa), 'coast' (default, the knee's hold torque, the torso's "
+                   "gains and the stance knee) or 'paper_motor' (what the paper does not print when the hip is "
+                   "its ODE motor: the motor's limit, the knees, ankles, torso and touchdown phase)")
     p.add_argument("--method", choices=["es", "cmaes"], default="es",
                    help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                    "offspring candidates a generation")
