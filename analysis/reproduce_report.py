@@ -19,7 +19,7 @@ from drake_biped.analysis.floquet import record_verdict
 from drake_biped.analysis.series import cmt_change, signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
-from drake_biped.records import save_figure, write_text_atomic
+from drake_biped.records import read_json, save_figure, write_text_atomic
 
 SLOPE_LEVEL_M = 2.0  # the level ground before the dynamics step's slopes (Reproduction.dynamics)
 REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
@@ -611,7 +611,7 @@ def full_run_digest(out: Path, verdicts: list[tuple[str, str, str, str]], profil
     window) gave, to be re-walked and compared. `code`: the report's own."""
     checks = {}
     for key, (source,) in CHECKED_SOURCES.items():
-        record = json.loads((out / source / "learning.json").read_text())
+        record = read_json(out / source / "learning.json", "the full run")
         ev = record["evaluation"]
         config = record["settings"]["config"]
         # What the record's own configuration walks: the paper's 10 m episode where the windows were re-walked

@@ -13,7 +13,7 @@ from typing import Any
 from drake_biped.params import ParameterError
 
 __all__ = ["LOCK_FILE", "RUN_FILE", "atomic_file", "claim_folder", "read_json", "read_kept", "read_kept_lines",
-           "save_figure", "set_aside", "warn", "write_atomic", "write_text_atomic"]
+           "save_figure", "set_aside", "stored", "warn", "write_atomic", "write_text_atomic"]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -32,15 +32,30 @@ def write_atomic(path: Path, data: Any) -> None:
     write_text_atomic(path, json.dumps(data, indent=1, allow_nan=False) + "\n")
 
 
-def read_json(path: Path, what: str) -> Any:
-    """The JSON in `path`, or ParameterError naming `what` (the option or command that gave the path) and the
-    file: missing, unreadable, not text, not JSON, or nested beyond what Python can parse."""
+def stored(path: Path) -> Path:
+    """Where the record `path` is kept: `path` itself, or PATH.gz when only the gzip-compressed form exists (a
+    large record kept in the repository is compressed: benchmarks/results/)."""
     path = Path(path)
+    packed = path.with_name(path.name + ".gz")
+    return packed if not path.exists() and packed.is_file() else path
+
+
+def read_json(path: Path, what: str) -> Any:
+    """The JSON in `path` (or in PATH.gz, or in a gzip-compressed `path` ending in .gz), or ParameterError
+    naming `what` (the option or command that gave the path) and the file: missing, unreadable, not text, not
+    JSON, or nested beyond what Python can parse."""
+    import gzip
+
+    path = stored(path)
     if not path.is_file():
         raise ParameterError(f"{what}: no such file: {path}")
     try:
-        text = path.read_text()
-    except OSError as exc:
+        if path.suffix == ".gz":
+            with gzip.open(path, "rt") as f:
+                text = f.read()
+        else:
+            text = path.read_text()
+    except (OSError, EOFError) as exc:
         raise ParameterError(f"{what} {path}: cannot be read ({exc.strerror or exc})") from None
     except UnicodeDecodeError as exc:
         raise ParameterError(f"{what} {path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None

@@ -257,3 +257,20 @@ def test_the_command_line_runs_its_bars_without_tqdms_monitor_thread(tmp_path):
     with pytest.raises(SystemExit):
         main(["walk", "--t1", "0.5", "--out", str(tmp_path / "w")])  # refused: --t1 without --t2
     assert tqdm.monitor_interval == 0
+
+
+def test_a_compressed_record_reads_as_the_record(tmp_path):
+    """A large record kept compressed (learning.json.gz beside no learning.json) reads where learning.json is
+    asked for, and a path ending in .gz reads as the JSON it holds."""
+    import gzip
+
+    from drake_biped.records import read_json
+
+    data = {"trials": [{"trial": 0, "final_mean": [0.3, 0.8]}]}
+    with gzip.open(tmp_path / "learning.json.gz", "wt") as f:
+        json.dump(data, f)
+    assert read_json(tmp_path / "learning.json", "--policy") == data
+    assert read_json(tmp_path / "learning.json.gz", "--policy") == data
+    (tmp_path / "bad.json.gz").write_bytes(b"\x1f\x8b not gzip")
+    with pytest.raises(ParameterError, match="bad.json.gz: cannot be read"):
+        read_json(tmp_path / "bad.json.gz", "--policy")
