@@ -123,7 +123,7 @@ JACOBIAN_TEXT = (
     "Kicks of the swing hip 30 ms before touchdown 8 (angle ε, rate 10ε, 16 directions); J by least squares "
     "from the measured Δx_n, Δx_n+1. The residual is the part of Δx_n+1 that J does not explain; where it is "
     "large, the step map's linear response is as small as its scatter (most likely the jumps of a controller "
-    "on a 1 ms grid) and J is not identifiable at that kick size.")
+    "on the controller's update grid) and J is not identifiable at that kick size.")
 JACOBIAN_COLUMNS = ("condition", "kick ε (rad)", "λ", "ρ", "residual", "regression ρ (undisturbed)")
 
 

@@ -1,7 +1,7 @@
 """Vector layouts declared once: named fields with their sizes, offsets generated from them.
 
 A LeafSystem's discrete state is a flat vector; its layout is declared here as a table of fields, and code
-outside the 1 kHz update reads it through named views (`layout.view(vector).cpg_phase`, `layout.rows(log,
+outside the update reads it through named views (`layout.view(vector).cpg_phase`, `layout.rows(log,
 "positive_work_j")`) instead of offset arithmetic. The update itself uses plain integer offsets taken from
 the same table (`layout.offset("cpg_phase")`), since every Python call there costs real time.
 """

@@ -192,7 +192,7 @@ SURE_STEP_TOLERANCE, SURE_STEP_PENALTY = 0.01, 10.0
 # The "hold-fine" objective: "hold-sure" with its one quarter step replaced by the time-step study's ladder. The
 # holding gait agreed at a quarter of the step over 40 m, yet its walk without a window moved by 2.0 % between a
 # half and an eighth of the step over 310 m (docs/RESULTS.md): FINE_STEP_M walks without a window at each of
-# FINE_STEP_FRACTIONS of the plant step, control period kept, and SURE_STEP_PENALTY x how far the largest change
+# FINE_STEP_FRACTIONS of the plant step, the gait's clock kept, and SURE_STEP_PENALTY x how far the largest change
 # from the finest moves beyond SURE_STEP_TOLERANCE (1 when one falls).
 FINE_STEP_FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 FINE_STEP_M = 60.0
@@ -548,7 +548,7 @@ def _quarter_step(config: EpisodeConfig, detail: dict[str, Any]) -> tuple[float,
 
 def _step_ladder(config: EpisodeConfig, detail: dict[str, Any]) -> tuple[float, dict[str, Any]]:
     """"hold-fine"'s step check: the penalty for the walks without a window at FINE_STEP_FRACTIONS of the plant
-    step (FINE_STEP_M each, control period kept), and what they measured."""
+    step (FINE_STEP_M each, the gait's clock kept: refined with the plant by default), and what they measured."""
     walks = [{"time_step_s": f * config.sim.time_step_s,
               **_long_walk(config.override({"sim.time_step_s": f * config.sim.time_step_s}
                                            ).replace(window=TorqueFreeWindow()), FINE_STEP_M)}
@@ -711,7 +711,7 @@ OBJECTIVES: dict[str, Objective] = {
     "hold-edge": Objective(_hold_edge_objective, True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-lure": Objective(_hold_lure_objective, True, 'The "robust" objective first, then HOLD_LURE_WINDOWS (t1 0.40 to 0.46 s, the hip off until the foot lands) judged as in "hold-long", plus HOLD_LURE_WEIGHT x the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s: what brings GARB\'s means back from the no-window half of its start): least saving + 0.5 x that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
     "hold-sure": Objective(_hold_sure_objective, True, 'The "hold-lure" score less SURE_FALL_PENALTY x the fraction of SURE_EARLY_WINDOWS (early windows, where GARB\'s first large steps can carry a mean) that fall over the 10 m episode, and less SURE_PUSH_PENALTY x the fraction of the +-PUSH_FORCE_N pushes in steady state (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a SURE_PUSH_M walk, as `push-margin` pushes; without a window and with SURE_PUSH_WINDOW) that fall, and less SURE_STEP_PENALTY x how far the long-run C_mt of the walk without a window at a quarter of the plant step moves beyond SURE_STEP_TOLERANCE from the step\'s (1 when it falls).'),
-    "hold-fine": Objective(_hold_fine_objective, True, 'The "hold-sure" score with its step check made the time-step study\'s: SURE_STEP_PENALTY x how far the largest change of the long-run C_mt without a window, walked FINE_STEP_M at each of FINE_STEP_FRACTIONS of the plant step (control period kept), from the finest moves beyond SURE_STEP_TOLERANCE (1 when one falls).'),
+    "hold-fine": Objective(_hold_fine_objective, True, 'The "hold-sure" score with its step check made the time-step study\'s: SURE_STEP_PENALTY x how far the largest change of the long-run C_mt without a window, walked FINE_STEP_M at each of FINE_STEP_FRACTIONS of the plant step (the controller refined with it under the paper's clock), from the finest moves beyond SURE_STEP_TOLERANCE (1 when one falls).'),
     "hold-pull": Objective(_hold_pull_objective, True, 'The "hold-edge" score plus the mean reward gain over --policy-draws fixed draws of the paper\'s start policy ((0.5, 0.5), variance 0.04; the "expected" objective): where the learner\'s first episodes fall or save.'),
 }
 
