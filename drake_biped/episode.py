@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import time
 from collections import OrderedDict
 from collections.abc import Callable
@@ -356,6 +357,23 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     ctrl_ctx.get_mutable_discrete_state()  # every group was written in place
 
 
+def check_record_memory(config: EpisodeConfig) -> None:
+    """ParameterError naming the time limit, before any work, when a recorded episode (its state, controller
+    state and torques logged at every update, or a Meshcat recording) could fill more than half this machine's
+    memory: a walk that may last `sim.max_time_s`, recorded, is bounded by it."""
+    samples = config.sim.max_time_s / config.sim.update_period_s
+    need = samples * 8.0 * 2 * (18 + ctl.N_STATE + 6)  # float64, the logs and their copy in the result
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        total = 8 << 30
+    if need > total / 2:
+        raise ParameterError(f"sim.max_time_s = {config.sim.max_time_s:g} (--max-time): a recorded walk that long would "
+                             f"hold about {need / 2**30:,.1f} GiB of logs at one sample per "
+                             f"{1e3 * config.sim.update_period_s:g} ms update, more than half this machine's "
+                             f"{total / 2**30:.0f} GiB; give a shorter time limit, or walk without recording")
+
+
 def run_episode(
     config: EpisodeConfig | None = None,
     meshcat=None,
@@ -378,6 +396,8 @@ def run_episode(
                              f"{cache!r}")
     if kick is not None and not isinstance(kick, Kick):
         raise ParameterError(f"run_episode: kick must be a Kick or None, got {type(kick).__name__}")
+    if record_trajectory or meshcat is not None:
+        check_record_memory(config)
     parts, simulator, reason, wall = simulate(
         config, meshcat=meshcat, progress=progress, record=record_trajectory, cache=cache, kick=kick
     )

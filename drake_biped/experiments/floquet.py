@@ -25,6 +25,7 @@ from drake_biped.analysis.return_map import complex_list
 from drake_biped.experiments.options import (
     add_cluster_options,
     add_episode_options,
+    check_size,
     chosen_window,
     cluster,
     count,
@@ -40,6 +41,12 @@ from drake_biped.versions import versions
 __all__ = ["FloquetSettings", "analyse", "markdown", "run"]
 
 DEFAULT_EPSILONS = tuple(float(10.0 ** e) for e in np.arange(-8.0, -2.49, 0.5))
+
+
+# The most step-map evaluations of one kind a Floquet run is given (settling steps, Newton's iterations, the
+# transient of the period search, the decay check), and the most perturbation sizes swept (each a Jacobian).
+MAX_MAP_STEPS = 1000
+MAX_EPSILONS = 40
 
 
 @dataclass(frozen=True)
@@ -75,6 +82,14 @@ class FloquetSettings:
                 raise ParameterError(f"{name} {value!r}: must be a positive number")
         if not isinstance(self.decay_steps, int) or self.decay_steps < 1:
             raise ParameterError(f"decay_steps {self.decay_steps!r}: must be an integer >= 1")
+        for name in ("newton_iterations", "period_transient"):
+            if not isinstance(getattr(self, name), int) or getattr(self, name) < 0:
+                raise ParameterError(f"{name} {getattr(self, name)!r}: must be an integer >= 0")
+        # every one of these is a walk of steps (each a step map's evaluation, 2 x 14 per Jacobian)
+        check_size(f"--settle-steps {self.settle_steps}", self.settle_steps, MAX_MAP_STEPS, "steps", None)
+        check_size(f"--epsilons ({len(self.epsilons)} sizes)", len(self.epsilons), MAX_EPSILONS, "Jacobians", None)
+        for name in ("newton_iterations", "period_transient", "decay_steps"):
+            check_size(f"{name} {getattr(self, name)}", getattr(self, name), MAX_MAP_STEPS, "steps", None)
 
     def to_dict(self) -> dict[str, Any]:
         return {"settle_steps": self.settle_steps, "epsilons": list(self.epsilons),

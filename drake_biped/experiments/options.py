@@ -24,12 +24,13 @@ MAX_CANDIDATES = 2_000  # gait-search candidates (generations x offspring)
 EPISODE_RECORD_BYTES = 8_192  # what one episode's kept record holds in memory, at most (its touchdown rows)
 
 
-def check_size(what: str, count: int, limit: int, unit: str, force: bool = False, advice: str = "give fewer") -> None:
+def check_size(what: str, count: int, limit: int, unit: str, force: bool | None = False,
+               advice: str = "give fewer") -> None:
     """ParameterError naming `what` (the options and values that set the size) when `count` `unit` exceed
-    `limit`, unless `force`: one line, before any work."""
+    `limit`, unless `force` (None: a limit that nothing lifts): one line, before any work."""
     if count > limit and not force:
-        raise ParameterError(f"{what}: {count:,} {unit}, more than the limit of {limit:,}; {advice}, or give "
-                             "--force (force=True) to run it anyway")
+        lift = "" if force is None else ", or give --force (force=True) to run it anyway"
+        raise ParameterError(f"{what}: {count:,} {unit}, more than the limit of {limit:,}; {advice}{lift}")
 
 
 def machine_memory_bytes() -> int:
