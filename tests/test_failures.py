@@ -126,6 +126,7 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
     (["grid", "--spec", "{file:spec_noop.yaml}", "--out", "{tmp}/g"], ["axis window.start_s", "changes nothing"]),
     (["walk", "--level-length", "2", "--out", "{tmp}/w"], ["--level-length 2", "changes nothing"]),
     (["walk", "--push", "0", "--out", "{tmp}/w"], ["--push 0", "changes nothing"]),
+    (["learn", "--rewalk-distance", "1000000", "--out", "{tmp}/l"], ["--rewalk-distance 1e+06", "distance_m"]),
     (["floquet", "--settle-steps", "1000000000", "--out", "{tmp}/f"], ["--settle-steps 1000000000", "limit of 1,000"]),
     (["walk", "--max-time", "100000", "--out", "{tmp}/w"], ["--max-time", "GiB of logs"]),
     (["walk", "--push", "20", "--push-duration", "0", "--out", "{tmp}/w"], ["--push-duration", "must be > 0"]),

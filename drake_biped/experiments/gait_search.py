@@ -35,11 +35,10 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.experiments.options import (
-    EPISODE_RECORD_BYTES,
     MAX_CANDIDATES,
+    MAX_WALKS,
     add_episode_options,
     add_resumable_run_options,
-    check_memory,
     check_size,
     cluster,
     count,
@@ -767,7 +766,8 @@ class GaitSearchSettings:
             )
         check_size(f"--generations {self.generations} x --offspring {self.offspring}",
                    self.generations * self.offspring, MAX_CANDIDATES, "candidates", self.force)
-        check_memory(f"--policy-draws {self.policy_draws}", self.policy_draws * EPISODE_RECORD_BYTES)
+        check_size(f"--policy-draws {self.policy_draws}", self.policy_draws, MAX_WALKS, "walks per candidate",
+                   self.force)
 
 
 def _search_start(settings: GaitSearchSettings) -> EpisodeConfig:

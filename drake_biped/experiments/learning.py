@@ -338,6 +338,17 @@ def run_learning(
     return trials, new
 
 
+def check_rewalk_distance(settings: dict[str, Any], distance_m: float) -> None:
+    """ParameterError naming --rewalk-distance unless the re-walks' configuration at `distance_m` is one an
+    episode takes (it is walked only after the learning)."""
+    try:
+        EpisodeConfig.from_dict(settings["config"]).override(
+            {"sim.distance_m": distance_m, "sim.max_time_s": max(settings["config"]["sim"]["max_time_s"],
+                                                                 6.0 * distance_m)})
+    except ParameterError as exc:
+        raise ParameterError(f"--rewalk-distance {distance_m:g}: {exc}") from None
+
+
 def evaluate(settings: dict[str, Any], trials: list[Trial], client, rewalk_distance_m: float = REWALK_M
              ) -> dict[str, Any]:
     """Table V's measured rows: the gait without a window, and with each trial's final policy mean; and every
@@ -439,15 +450,16 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
 
     out = Path(out)
     record_settings = settings.record() if isinstance(settings, LearningSettings) else settings
+    if rewalk_distance_m is None:
+        distance = record_settings["config"]["sim"]["distance_m"]
+        rewalk_distance_m = REWALK_M if distance >= PAPER_EPISODE_M else distance
+    check_rewalk_distance(record_settings, rewalk_distance_m)  # before the learning, not after it
     versions()  # the code version this process runs, recorded now (it is cached), not at the run's end
     report = RunProgress(out, workers, scheduler, "learning", "episode", bar=progress, command="learn")
     try:
         with client_or_local(client) as c:
             trials, new = run_learning(out, record_settings, c, report)
             report.log.update(new, force=True)
-            if rewalk_distance_m is None:
-                distance = record_settings["config"]["sim"]["distance_m"]
-                rewalk_distance_m = REWALK_M if distance >= PAPER_EPISODE_M else distance
             evaluation = evaluate(record_settings, trials, c, rewalk_distance_m)
     finally:
         report.close()
@@ -532,6 +544,8 @@ def command(args: argparse.Namespace) -> int:
     from drake_biped.experiments.progress import check_run_log
 
     record_settings = settings_from_args(args).record()  # validated before a cluster starts
+    if args.rewalk_distance is not None:
+        check_rewalk_distance(record_settings, args.rewalk_distance)
     out = Path(args.out)
     check_resume(record_settings, out)
     check_run_log(out, "learn")  # before a cluster starts
