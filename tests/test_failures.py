@@ -256,7 +256,7 @@ def test_the_run_log_counts_the_episodes_a_killed_session_never_logged(tmp_path,
 
 @pytest.mark.slow
 def test_ctrl_c_is_one_line_exit_130_and_the_same_command_resumes(tmp_path):
-    argv = [sys.executable, "-m", "drake_biped", "learn", "--trials", "2", "--episodes", "40", "--distance", "1",
+    argv = [sys.executable, "-m", "drake_biped", "learn", "--trials", "2", "--episodes", "400", "--distance", "1",
             "--workers", "2", "--out", str(tmp_path / "l")]
     p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))

@@ -105,7 +105,7 @@ def test_an_output_folder_keeps_one_profile(tmp_path):
         check_out(tmp_path, Profile("full", *[getattr(QUICK, f) for f in list(QUICK.__dataclass_fields__)[1:]]))
 
 
-SMOKE = Profile("smoke", distance_m=5.0, grid_points=1, grid_initiation_points=1, learn=(1, 2),
+SMOKE = Profile("smoke", distance_m=8.0, grid_points=1, grid_initiation_points=1, learn=(1, 2),
                 learn_variant=(1, 2), window_step_s=0.4, stability_trials=1, jacobian=False,
                 margin_force_step_n=50.0, slope=(1, 1), slope_grid_full=False, time_steps=(0.0005, 0.001),
                 time_step_distance_m=2.0, expected_minutes=1.0, floquet_epsilons=(1e-6, 1e-5, 1e-4),

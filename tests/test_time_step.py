@@ -116,3 +116,26 @@ def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp
 
     args = build_parser().parse_args(["time-step-study", "--out", str(tmp_path / "y"), "--control-period", "0.001"])
     assert time_step.settings_from_args(args).steps == (0.001, 0.0005, 0.00025, 0.000125)
+
+
+def test_walks_too_short_for_a_long_run_mean_compare_the_whole_walk_and_say_so(monkeypatch, tmp_path, capsys):
+    """A study of 3 m walks is refused unless told to compare the whole walks' C_mt (--measure episode); then its
+    report says that is what it compared, and gives no Richardson estimate of two steps."""
+    from drake_biped.experiments import time_step
+
+    with pytest.raises(SystemExit) as exc:
+        main(["time-step-study", "--steps", "0.002,0.001", "--distance", "3", "--out", str(tmp_path / "x")])
+    assert exc.value.code == 2 and "--measure episode" in capsys.readouterr().err
+
+    def fake_map(client, fn, items, on_result=None):
+        return [{"fell": False, "distance_m": 3.0, "termination": "distance", "mass_kg": 10.0,
+                 "cost_of_transport": 0.6 + c["sim"]["time_step_s"], "steps": [], "mean_speed_mps": 1.0,
+                 "step_period_s": 0.4, "real_time_factor": 5.0} for c in items]
+
+    monkeypatch.setattr(time_step, "map_ordered", fake_map)
+    rec = time_step.study([0.001, 0.002], 0.001, 3.0, None, progress=False, windows=[], measure="episode")
+    rec.update(versions={"git_commit": "x", "drake": "y"}, date="d")
+    text = time_step.markdown(rec)
+    assert "C_mt is the whole walk's" in text and "the long-run mean after" not in text
+    assert "0.6010 (0.0 %)" in text and "0.6020 (+0.2 %)" in text
+    assert "Not computed: it needs three finest steps that halve" in text

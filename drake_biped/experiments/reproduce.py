@@ -39,6 +39,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.long_run import has_long_run
 from drake_biped.experiments.options import (
     add_resumable_run_options,
     cluster,
@@ -292,8 +293,10 @@ class Reproduction:
                     "windows": [list(w) for w in windows], "learned_window_source": source}
 
         def run(folder: Path) -> dict:
+            # walks too short for a long-run mean (a small profile) compare the whole walk's C_mt, and say so
+            measure = "long-run" if has_long_run(p.time_step_distance_m) else "episode"
             rec = time_step.run(time_step.TimeStepSettings(tuple(p.time_steps), min(p.time_steps),
-                                                           p.time_step_distance_m, windows=windows),
+                                                           p.time_step_distance_m, windows=windows, measure=measure),
                                 folder, self._client, progress=False)
             return {"chosen_step_s": rec["chosen_step_s"], "passing_steps": rec["passing_steps"]}
 

@@ -62,6 +62,9 @@ WALKS = [None, LEARNED_WINDOW_S, (0.3, 0.6)]
 TOLERANCE = 0.01
 LONG_WALK_M = TRANSIENT_M + LONG_RUN_M
 STEPS = (0.002, 0.001, 0.0005, 0.00025, 0.000125)
+# What a study compares at each step: the long-run mean after the transient (with its 95 % interval), or, for walks
+# too short for one, the whole walk's C_mt (initiation included, no interval).
+MEASURES = ("long-run", "episode")
 
 
 def label(window) -> str:
@@ -69,7 +72,7 @@ def label(window) -> str:
 
 
 def study(steps: list[float], reference: float, distance: float, client, progress: bool = True,
-          config: EpisodeConfig | None = None, windows=None) -> dict:
+          config: EpisodeConfig | None = None, windows=None, measure: str = "long-run") -> dict:
     base = config if config is not None else EpisodeConfig()
     walk_list = WALKS if windows is None else [None, *map(tuple, windows)]
     jobs = []
@@ -94,14 +97,14 @@ def study(steps: list[float], reference: float, distance: float, client, progres
             "termination": r["termination"],
             "distance_m": r["distance_m"],
             "episode_cost_of_transport": r["cost_of_transport"],
-            "cost_of_transport": long_run["cost_of_transport"],
-            "half_width": long_run["half_width"],
+            "cost_of_transport": long_run["cost_of_transport"] if measure == "long-run" else r["cost_of_transport"],
+            "half_width": long_run["half_width"] if measure == "long-run" else None,
             "long_run": long_run,
             "mean_speed_mps": r["mean_speed_mps"],
             "step_period_s": long_run["step_period_mean_s"],
             "real_time_factor": r["real_time_factor"],
         })
-    rec = {"steps": steps, "reference_s": reference, "distance_m": distance, "tolerance": TOLERANCE,
+    rec = {"steps": steps, "reference_s": reference, "distance_m": distance, "tolerance": TOLERANCE, "measure": measure,
            "walks": [list(w) if w else None for w in walk_list], "config": base.to_dict(), "rows": rows,
            **choose_step(rows, steps, reference, TOLERANCE)}
     rec["richardson"] = {json.dumps(w): richardson(rows, steps, w) for w in rec["walks"]}
@@ -214,7 +217,8 @@ def markdown(rec: dict) -> str:
         noise = r.get("deviation_noise") or 0.0
         mark = ("" if dev is None or abs(dev) <= rec["tolerance"]
                 else " ≈" if abs(dev) <= noise else " ✗")
-        text = format_cost_interval(r["cost_of_transport"], r["half_width"])
+        text = (format_cost(r["cost_of_transport"]) if r.get("half_width") is None
+                else format_cost_interval(r["cost_of_transport"], r["half_width"]))
         return f"{text} ({signed_percent(dev)}){mark}" if dev is not None else text
 
     chosen = rec["chosen_step_s"]
@@ -239,22 +243,28 @@ def markdown(rec: dict) -> str:
         clock = ("The controller is a fixed-rate loop, part of the robot, so the plant step alone is refined under it; "
                  "control period at each step: " + ", ".join(f"{h * 1e3:g} ms → {c * 1e3:g} ms" for h, c in control
                                                               if c is not None) + ".")
+    long_run = rec.get("measure", "long-run") == "long-run"
+    measured = (f"C_mt is the long-run mean after the first {TRANSIENT_M:g} m, with its 95 % interval (batch means over "
+                "steps)" if long_run else "C_mt is the whole walk's, the initiation included (no interval: the walks "
+                f"are too short for a long-run mean, which needs {TRANSIENT_M + LONG_RUN_M:g} m)")
+    what = "long-run C_mt" if long_run else "whole walk's C_mt"
     lines = [
-        "# Time-step study: the long-run cost of transport as the plant step is halved",
+        f"# Time-step study: the {'long-run ' if long_run else ''}cost of transport as the plant step is halved",
         "",
-        f"{rec.get('gait', 'Default gait')}, {rec['distance_m']:g} m walks from the paper's initiation; C_mt is the "
-        f"long-run mean after the first {TRANSIENT_M:g} m, with its 95 % interval (batch means over steps); "
+        f"{rec.get('gait', 'Default gait')}, {rec['distance_m']:g} m walks from the paper's initiation; {measured}; "
         f"reference {rec['reference_s'] * 1e3:g} ms. {clock} Contact: {_contact_text(rec['config'])}. Commit {rec['versions']['git_commit']}, "
         f"Drake {rec['versions']['drake']}, {rec['date']}.",
         "",
-        f"**Chosen step: {chosen * 1e3:g} ms**, the coarsest with the long-run C_mt of every walk that walks at "
-        f"the reference within {100 * rec['tolerance']:g} % of it, or within the 95 % interval of the difference "
-        "(≈: indistinguishable at this length), and every finer step too." if chosen else
+        f"**Chosen step: {chosen * 1e3:g} ms**, the coarsest with the {what} of every walk that walks at "
+        f"the reference within {100 * rec['tolerance']:g} % of it"
+        + (", or within the 95 % interval of the difference (≈: indistinguishable at this length)" if long_run else "")
+        + ", and every finer step too." if chosen else
         "**No step passes** the tolerance for every walk.",
         "",
         *([f"Not judged (they fall at the reference step): {', '.join(label(w) for w in rec['not_judged'])}.", ""]
           if rec["not_judged"] else []),
-        "## Long-run C_mt ± 95 % (change from the reference)",
+        "## Long-run C_mt ± 95 % (change from the reference)" if long_run else
+        "## The whole walk's C_mt (change from the reference)",
         "",
         *table(cmt),
         "",
@@ -333,6 +343,7 @@ class TimeStepSettings:
     gait: str = "Default gait"
     windows: tuple[tuple[float, float], ...] | None = None
     force: bool = False  # more than MAX_WALKS walks
+    measure: str = "long-run"  # what is compared: the long-run mean (MEASURES)
 
     def __post_init__(self) -> None:
         sim = (self.config or EpisodeConfig()).sim
@@ -343,10 +354,13 @@ class TimeStepSettings:
         for t1, t2 in self.windows or ():
             if not 0.0 <= t1 < t2:
                 raise ParameterError(f"--windows {t1:g}-{t2:g}: need 0 <= t1 < t2")
-        if not has_long_run(self.distance_m):
+        if self.measure not in MEASURES:
+            raise ParameterError(f"--measure {self.measure!r} is not one of {list(MEASURES)}")
+        if self.measure == "long-run" and not has_long_run(self.distance_m):
             raise ParameterError(f"--distance {self.distance_m:g}: the study compares long-run means, which need "
                                  f"walks of at least {TRANSIENT_M + LONG_RUN_M:g} m (the first {TRANSIENT_M:g} m "
-                                 f"dropped, {LONG_RUN_M:g} m measured)")
+                                 f"dropped, {LONG_RUN_M:g} m measured); give --measure episode to compare the whole "
+                                 "walks' C_mt instead")
         if len(set(self.steps)) != len(self.steps):
             raise ParameterError(f"--steps {','.join(f'{h:g}' for h in self.steps)}: a step is given twice")
         check_walks(f"--steps ({len(self.steps)}) x walks ({1 + len(self.windows or WALKS[1:])})",
@@ -365,7 +379,7 @@ def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = Tru
     t0 = time.perf_counter()
     with client_or_local(client) as c:
         rec = study(steps, settings.reference_s, settings.distance_m, c, progress, settings.config,
-                    settings.windows)
+                    settings.windows, settings.measure)
     rec.update(gait=settings.gait, date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), versions=versions(), wall_s=time.perf_counter() - t0)
     write_text_atomic(out / "time_step_study.json", json.dumps(rec, indent=2) + "\n")
     replot(out)
@@ -407,6 +421,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--windows", type=windows,
                    help="the windows compared with none, T1-T2 in s, comma-separated (default "
                    "0.3672-0.8629,0.3-0.6: the default gait's learned window and one early in the swing)")
+    p.add_argument("--measure", choices=MEASURES, default="long-run",
+                   help="what is compared at each step: the long-run mean after the first 10 m (walks of 110 m or "
+                   "more), or the whole walk's C_mt ('episode', any distance)")
     add_cluster_options(p)
     p.add_argument("--replot", action="store_true", help="redraw the table and figure from OUT's JSON")
     p.add_argument("--out", required=True, type=out_folder, help="output folder")
@@ -428,7 +445,8 @@ def settings_from_args(args: argparse.Namespace) -> TimeStepSettings:
     reference = min(chosen) if args.reference is None else args.reference
     return TimeStepSettings(tuple(chosen), reference, args.distance, config,
                             "Default gait" if args.params is None else f"Gait {args.params}",
-                            None if args.windows is None else tuple(args.windows), force=args.force)
+                            None if args.windows is None else tuple(args.windows), force=args.force,
+                            measure=args.measure)
 
 
 def command(args: argparse.Namespace) -> int:
