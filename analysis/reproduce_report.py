@@ -231,6 +231,17 @@ def _bound(premise: dict[str, Any], key: str) -> str:
     return ("≥ " if premise.get(f"{key}_is_bound") else "") + f"{value:g}"
 
 
+def _hip_reading(paper_gait: dict[str, Any]) -> str:
+    """How the `paper` gait's hip realizes zeta, from its summary (a summary without its gait is of the
+    integrated servo reading, the `paper` gait then)."""
+    gait = paper_gait.get("gait") or {"hip_drive": "servo", "swing_reading": "integrated"}
+    if gait.get("hip_drive") == "motor":
+        joint = "the swing hip joint" if gait.get("hip_joint", "swing") == "swing" else "the inter-leg angle"
+        return (f"ζ the desired velocity of {joint}, realized by an effort-limited velocity motor as ODE's "
+                f"({gait['motor_limit_nm']:.3g} N·m), at {1e3 * paper_gait.get('time_step_s', 1e-3):g} ms")
+    return f"ζ driving the swing thigh's angle through a soft servo (the {gait.get('swing_reading')} reading)"
+
+
 def _dynamics_walks_m(d: dict[str, Any]) -> tuple[float, float, float, float]:
     """The dynamics step's walk lengths (m): the attractors, the sweeps, the slopes (2 m level included), the
     basins (Profile.dynamics_walks_m, recorded in its settings)."""
@@ -399,8 +410,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "## Table III as printed (`paper_gait/`)",
         "",
         f"The shipped gait `paper`: Table III's CPG ({', '.join(f'{k} {v:g}' for k, v in pg['cpg'].items())}) and the "
-        f"paper's initiation, ζ driving the swing unscaled (the integrated reading), the gains the paper does not "
-        f"print from a search of 1 430 candidates (docs/HISTORY.md): "
+        f"paper's initiation, {_hip_reading(pg)}, the gains the paper does not print searched (the gait's `about`): "
         + (f"walks {pg['distance_m']:.2f} m" if not pg["fell"] else f"falls after {_steps(pg['steps'])} ({pg['fall_reason']}), "
                                               f"{pg['distance_m']:.2f} m")
         + ". Record: [result.json](paper_gait/result.json).",

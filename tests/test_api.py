@@ -92,14 +92,17 @@ def test_controller_state_is_read_by_name():
 
 
 def test_the_paper_gait_holds_table_iii_and_the_paper_initiation_as_printed():
-    """`--params paper`: Table III's CPG and the initiation exactly, zeta driving the swing unscaled; only
-    the gains the paper does not print were searched."""
+    """`--params paper`: Table III's CPG and the initiation exactly, the hip the paper's ODE motor on the swing hip
+    joint; `paper_servo`, the same CPG and initiation under the soft servo of the thigh's angle (integrated)."""
     from drake_biped.paper import INITIAL_HIP_ANGLE_RAD, INITIAL_SPEED_MPS, TABLE_III
 
-    paper = drake_biped.load_gait("paper")
-    assert paper.cpg.to_dict() == TABLE_III
-    assert paper.initial.hip_angle_rad == INITIAL_HIP_ANGLE_RAD and paper.initial.speed_mps == INITIAL_SPEED_MPS
-    assert paper.gait.swing_reading == "integrated"
+    for name in ("paper", "paper_servo"):
+        paper = drake_biped.load_gait(name)
+        assert paper.cpg.to_dict() == TABLE_III
+        assert paper.initial.hip_angle_rad == INITIAL_HIP_ANGLE_RAD and paper.initial.speed_mps == INITIAL_SPEED_MPS
+    assert drake_biped.load_gait("paper").gait.hip_drive == "motor"
+    assert drake_biped.load_gait("paper").gait.hip_joint == "swing"
+    assert drake_biped.load_gait("paper_servo").gait.swing_reading == "integrated"
 
 
 def test_learners_from_the_top_level_api():

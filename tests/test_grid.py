@@ -155,7 +155,7 @@ def test_shipped_specs_and_parameter_files_are_valid():
         for point in grid_points(load_spec(name)):
             point_config(EpisodeConfig(), point)
     assert gait_names() == ["attracting", "climbing", "climbing_2deg", "coasting", "coasting_garb", "coasting_wide",
-                            "default", "holding", "paper", "paper_entrained", "steady"]
+                            "default", "holding", "paper", "paper_entrained", "paper_servo", "steady"]
     for name in ("climbing", "climbing_2deg"):  # the climbing gaits differ from steady by the grid's axes
         assert load_gait(name).gait.torso_pitch_rad < load_gait("steady").gait.torso_pitch_rad
 

@@ -102,3 +102,19 @@ def test_the_work_counted_is_that_of_the_torque_the_plant_applied():
     offline = positive_work(T["actuation"][:-1], np.diff(T["positions"][:, 3:], axis=0) / dt, dt)
     np.testing.assert_allclose(T["positive_work"][-1], offline, rtol=1e-9, atol=1e-9)
     assert np.max(np.abs(T["actuation"][:, [0, 3]])) > 5.0  # the motor did work
+
+
+@pytest.mark.slow
+def test_the_paper_gait_walks_table_iii_with_the_paper_hip():
+    """The shipped `paper` gait (Table III, the paper's initiation, the ODE motor on the swing hip) walks: 30 m at
+    its step and at half of it, and through the paper's +-20 N pushes at 0.4 s over 10 m."""
+    from drake_biped.params import Push
+    from drake_biped.resources import load_gait
+
+    paper = load_gait("paper")
+    for h in (paper.sim.time_step_s, 0.5 * paper.sim.time_step_s):
+        r = run_episode(paper.override({"sim.time_step_s": h, "sim.distance_m": 30.0, "sim.max_time_s": 120.0}))
+        assert not r.fell and r.distance_m >= 30.0 and 0.8 < r.step_period_s < 1.0
+    for force in (20.0, -20.0):
+        r = run_episode(paper.replace(push=Push(force, 0.4, 0.1)))
+        assert not r.fell and r.distance_m >= 10.0

@@ -209,7 +209,8 @@ class Reproduction:
             r = walk.run(walk.WalkSettings(config, animation=False), folder, progress=False)
             return {"distance_m": r.distance_m, "fell": r.fell, "fall_reason": r.fall_reason, "steps": len(r.steps),
                     "cost_of_transport": r.cost_of_transport, "cpg": config.cpg.to_dict(),
-                    "initial": config.initial.to_dict()}
+                    "initial": config.initial.to_dict(), "gait": config.gait.to_dict(),
+                    "time_step_s": config.sim.time_step_s}
 
         return self.experiment("paper_gait", {"config": config.to_dict()}, run)
 
