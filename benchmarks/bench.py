@@ -30,10 +30,10 @@ from pathlib import Path
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from drake_biped.common.executor import dask_client, episode_task, map_ordered, peak_rss_mb
 from drake_biped.controller import N_STATE, CpgWalkingController
 from drake_biped.diagram import build_replay_diagram, initial_state
 from drake_biped.episode import run_episode
-from drake_biped.experiments.executor import dask_client, episode_task, map_ordered, peak_rss_mb
 from drake_biped.kinematics import center_of_mass
 from drake_biped.params import EpisodeConfig, SimulationParams, TorqueFreeWindow
 from drake_biped.versions import versions

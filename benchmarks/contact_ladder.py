@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
+from drake_biped.common.executor import dask_client
 from drake_biped.experiments import time_step
-from drake_biped.experiments.executor import dask_client
 from drake_biped.params import EpisodeConfig
 from drake_biped.records import write_text_atomic
 from drake_biped.versions import versions

@@ -17,14 +17,14 @@ from contextlib import contextmanager
 from pathlib import Path
 
 # MADE: the folders --out made; integer, number, windows: the option types the examples give their own parsers.
-from drake_biped.experiments.options import MADE, integer, number, windows  # noqa: F401
+from drake_biped.common.options import MADE, integer, number, windows  # noqa: F401
 from drake_biped.model import ModelError
 from drake_biped.params import ParameterError
 
 
 def cmd_figures(args: argparse.Namespace) -> int:
     from drake_biped.analysis.figures import learning_figures
-    from drake_biped.experiments.learning_record import check_learning_record
+    from drake_biped.common.learning_record import check_learning_record
     from drake_biped.records import read_json
 
     out = Path(args.dir)

@@ -7,7 +7,7 @@ from drake_biped.params import EpisodeConfig, SimulationParams
 @pytest.fixture(scope="session")
 def client():
     """A LocalCluster of two workers, shared by the tests that run episodes in parallel."""
-    from drake_biped.experiments.executor import dask_client
+    from drake_biped.common.executor import dask_client
 
     with dask_client(workers=2) as c:
         yield c

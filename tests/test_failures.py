@@ -388,7 +388,7 @@ def test_a_failed_drake_check_is_a_drake_failure_through_the_api_and_one_line_on
 
     import drake_biped as db
     from drake_biped import episode, model
-    from drake_biped.experiments.executor import episode_task
+    from drake_biped.common.executor import episode_task
 
     monkeypatch.setattr(model, "_add_ground", lambda plant, ground, contact: trigger_an_assertion_failure())
     monkeypatch.setattr(episode._CACHE, "_entries", OrderedDict())  # no diagram built before this test
@@ -532,7 +532,8 @@ def test_version_prints_the_package_the_commit_and_drake(capsys):
 
 
 def test_runaway_sizes_through_the_api_are_refused_unless_forced():
-    from drake_biped.experiments import executor, grid
+    from drake_biped.common import executor
+    from drake_biped.experiments import grid
 
     with pytest.raises(ParameterError, match=r"GridSettings.axes: the grid has 78,125 points \(5 x 5 x 5 x 5 x 5 x 5 "
                                              r"x 5\), more than the limit of 20,000 .* or force=True"):
@@ -596,7 +597,8 @@ def test_window_map_prints_c_mt_to_four_significant_digits_and_what_it_wrote(tmp
     # It printed C_mt=0.22461234567890123 and no "wrote" line; then 0.000 for a small C_mt.
     from contextlib import nullcontext
 
-    from drake_biped.experiments import executor, window_map
+    from drake_biped.common import executor
+    from drake_biped.experiments import window_map
 
     row = {"t1": 0.2, "t2": 0.5, "walked": True, "cost_of_transport": 0.12345678901234567, "cmt_change": -0.45}
     record = {"config": {"sim": {"distance_m": 10.0}}, "windows": [row],
@@ -628,7 +630,7 @@ def test_a_run_log_belongs_to_one_command_and_another_command_is_refused_before_
     assert log.read_text() == before and sorted(p.name for p in (tmp_path / "l").iterdir()) == files
     # a folder whose records name no run (written through the API): the learning run's own log refuses it
     # and the other way round, through the API too: a grid's log is never a learning run's
-    from drake_biped.experiments.progress import RunProgress, SessionLog
+    from drake_biped.common.progress import RunProgress, SessionLog
 
     grid_out = tmp_path / "g"
     report = RunProgress(grid_out, None, None, "grid", "point", bar=False, command="grid")
@@ -644,7 +646,7 @@ def test_a_run_log_belongs_to_one_command_and_another_command_is_refused_before_
 
 
 def test_a_run_log_from_before_logs_named_their_command_is_taken_over(tmp_path):
-    from drake_biped.experiments.progress import SessionLog
+    from drake_biped.common.progress import SessionLog
 
     path = tmp_path / "run.json"
     path.write_text(json.dumps({"sessions": [{"episodes": 2, "learning_wall_s": 1.0, "finished": True}]}))
@@ -658,7 +660,7 @@ def test_a_failed_drake_check_in_a_dask_task_reaches_the_driver_as_a_drake_failu
     """On a worker, pydrake's SystemExit would end the worker, not the task: every task the experiments map
     over the cluster (map_ordered) raises it as DrakeFailure, which the driver gets like any task error."""
     from drake_biped.api_guard import DrakeFailure
-    from drake_biped.experiments.executor import dask_client, map_ordered
+    from drake_biped.common.executor import dask_client, map_ordered
 
     def window_row(_):  # as an experiment's task would, deep inside Drake
         from pydrake.common import trigger_an_assertion_failure

@@ -47,8 +47,8 @@ LAYERS = {
     "drake_biped.__main__": CLI,
 }
 # Package __init__ files hold docstrings and re-exports only (drake_biped's own imports lazily).
-PACKAGES = {"drake_biped", "drake_biped.analysis", "drake_biped.experiments", "drake_biped.learners",
-            "drake_biped.models"}
+PACKAGES = {"drake_biped", "drake_biped.analysis", "drake_biped.common", "drake_biped.experiments",
+            "drake_biped.learners", "drake_biped.models"}
 
 
 def modules() -> dict[str, Path]:
@@ -64,7 +64,7 @@ def modules() -> dict[str, Path]:
 
 
 def layer(name: str) -> int:
-    if name.startswith("drake_biped.experiments."):
+    if name.startswith(("drake_biped.experiments.", "drake_biped.common.")):
         return EXPERIMENTS
     return LAYERS[name]
 

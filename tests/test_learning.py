@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from drake_biped.cli import main
-from drake_biped.experiments.executor import dask_client
+from drake_biped.common.executor import dask_client
 from drake_biped.experiments.learning import Trial, make_settings, reward, run_learning, trial_seed, window_of
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
 
@@ -192,7 +192,7 @@ def test_learn_refuses_bad_options(tmp_path, capsys, argv, match):
 
 
 def test_run_log_keeps_every_session_and_their_totals(tmp_path):
-    from drake_biped.experiments.progress import SessionLog
+    from drake_biped.common.progress import SessionLog
 
     path = tmp_path / "run.json"
     first = SessionLog(path, workers=2, scheduler=None, every_s=0.0)

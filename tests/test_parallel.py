@@ -2,8 +2,8 @@
 
 import pytest
 
+from drake_biped.common.executor import check_scheduler_address, dask_client, episode_task, map_ordered
 from drake_biped.episode import run_episode
-from drake_biped.experiments.executor import check_scheduler_address, dask_client, episode_task, map_ordered
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams, TorqueFreeWindow
 
 

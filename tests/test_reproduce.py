@@ -120,7 +120,7 @@ SECTIONS = ("## The walk", "## Grid search, Table IV", "## Table III as printed"
 
 @pytest.mark.slow
 def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_path):
-    from drake_biped.experiments.executor import dask_client
+    from drake_biped.common.executor import dask_client
 
     logs = []
     with dask_client(workers=2) as client:
@@ -245,7 +245,7 @@ def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_nu
     """The quick profile's check of the shipped full run: every learned window (and no window) re-walked
     gives the C_mt the full run recorded, to the last digit; its report carries both columns."""
     quick = Profile(**{**QUICK.to_dict(), "steps": ("walk", "table_iii", "full_run"), "distance_m": 2.0})
-    from drake_biped.experiments.executor import dask_client
+    from drake_biped.common.executor import dask_client
 
     with dask_client(workers=2) as client:
         summaries = Reproduction(tmp_path, quick, client, workers=2, log=lambda _: None).run_all()

@@ -139,7 +139,7 @@ def test_a_window_map_keeps_every_finished_episode_and_sets_a_damaged_log_aside(
 def test_a_scheduler_without_workers_is_said_within_seconds(monkeypatch):
     from distributed import LocalCluster
 
-    from drake_biped.experiments import executor
+    from drake_biped.common import executor
 
     monkeypatch.setattr(executor, "WORKER_WAIT_S", 1.0)
     with LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) as cluster:
@@ -220,7 +220,7 @@ def test_a_cluster_that_loses_every_worker_is_said_within_seconds(monkeypatch):
 
     from distributed import LocalCluster
 
-    from drake_biped.experiments import executor
+    from drake_biped.common import executor
 
     monkeypatch.setattr(executor, "WORKER_WAIT_S", 1.0)
     with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:

@@ -100,7 +100,7 @@ def test_slope_story_on_a_short_setting(tmp_path):
     """2 m level, then 2 m up 0.02 rad. `steady` does not climb. The climbing gait found by the
     grid search climbs without a torque-free period and falls with the 0.2-0.4 s period that saves energy
     on level ground; a rerun recomputes nothing."""
-    from drake_biped.experiments.executor import dask_client
+    from drake_biped.common.executor import dask_client
 
     sim = SimulationParams(distance_m=4.0, max_time_s=20.0)
     climbing = load_gait("climbing").replace(sim=sim)

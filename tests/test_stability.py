@@ -123,7 +123,7 @@ def test_bad_settings_are_refused():
 
 @pytest.mark.slow
 def test_a_rerun_recomputes_nothing(tmp_path):
-    from drake_biped.experiments.executor import dask_client
+    from drake_biped.common.executor import dask_client
 
     base = EpisodeConfig(sim=SimulationParams(distance_m=1.2, max_time_s=6.0))
     s = StabilitySettings(trials=1, steady_from_step=1, bootstrap=0)
@@ -145,7 +145,8 @@ def test_push_margin_is_the_largest_force_every_phase_survives_however_survival_
     one phase only, and survives again above): the margin is the largest grid force at and below which every
     phase survives, every force of the grid is walked at every phase, and the pushes land in the first step
     that starts after the settling time, at its phases."""
-    from drake_biped.experiments import executor, push_margin
+    from drake_biped.common import executor
+    from drake_biped.experiments import push_margin
 
     def fake_map(client, fn, items, progress=None):
         out = []
@@ -236,7 +237,7 @@ def test_finite_difference_jacobian_recovers_a_known_step_map():
 
 def test_policy_option_takes_the_best_learned_window(tmp_path, capsys):
     from drake_biped.cli import main
-    from drake_biped.experiments.options import policy_window as _policy_window
+    from drake_biped.common.options import policy_window as _policy_window
 
     learned = [{"trial": 0, "t1": 0.5, "t2": 0.3, "cost_of_transport": 0.221, "fell": False},
                {"trial": 1, "t1": 0.14, "t2": 0.30, "cost_of_transport": 0.144, "fell": False},

@@ -18,8 +18,7 @@ import numpy as np
 from drake_biped.analysis.attractor import step_period_label
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import TRANSIENT_M
-from drake_biped.experiments.bifurcation import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
     add_window_options,
@@ -28,6 +27,7 @@ from drake_biped.experiments.options import (
     number,
     out_folder,
 )
+from drake_biped.experiments.bifurcation import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
 from drake_biped.experiments.stability import CONDITIONS, condition_window
 from drake_biped.params import LEARNED_WINDOW_S, EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
@@ -74,7 +74,7 @@ def start_config(settings: BasinSettings, condition: str, hip_angle: float, spee
 
 def basins(settings: BasinSettings, out: Path, client, progress=None) -> dict[str, Any]:
     """The record of `settings` on `client`: per condition, a grid [hip angle][speed] of what each start ends on."""
-    from drake_biped.experiments.executor import run_kept
+    from drake_biped.common.executor import run_kept
 
     jobs = {}
     for condition in CONDITIONS:
@@ -173,8 +173,8 @@ def run(settings: BasinSettings, out: Path, client=None, progress: bool = True) 
     """The slice on `client` (a LocalCluster when None); writes basins.json, basins.md and basins.png into `out`
     (the walks kept in out/walks). The record."""
     check_settings(settings, BasinSettings, "basins.run")
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import progress_bar
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import progress_bar
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -228,7 +228,7 @@ def settings_from_args(args: argparse.Namespace) -> BasinSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.options import cluster
+    from drake_biped.common.options import cluster
 
     settings = settings_from_args(args)
     with cluster(args) as client:

@@ -36,7 +36,7 @@ from drake_biped.analysis.attractor import (
 )
 from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.analysis.long_run import TRANSIENT_M, long_run_cost
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     EPISODE_RECORD_BYTES,
     add_cluster_options,
     add_episode_options,
@@ -191,7 +191,7 @@ def walks(settings: BifurcationSettings, out: Path, client, progress: Callable[[
           ) -> dict[tuple[int, float, bool], dict[str, Any]]:
     """Every point's walk, and the neighbour walk of each irregular one, kept in out/walks as each finishes;
     results by (index, time step, neighbour)."""
-    from drake_biped.experiments.executor import run_kept
+    from drake_biped.common.executor import run_kept
 
     jobs: dict[Any, tuple] = {(i, h, False): (_walk_path(out, i, h), point_config(settings, value, h).to_dict())
                               for i, value in enumerate(settings.values) for h in settings.time_steps}
@@ -327,8 +327,8 @@ def run(settings: BifurcationSettings, out: Path, client=None, progress: bool = 
     """The diagram on `client` (a LocalCluster when None); writes bifurcation.json, bifurcation.md and
     bifurcation.png into `out` (the walks and orbits kept in out/walks and out/orbits). The record."""
     check_settings(settings, BifurcationSettings, "bifurcation.run")
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import progress_bar
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import progress_bar
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -351,7 +351,7 @@ PARSER = dict(help="long walks over a range of one parameter: the attractor each
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped bifurcation`'s options."""
-    from drake_biped.experiments.options import add_window_options
+    from drake_biped.common.options import add_window_options
 
     p.add_argument("--param", required=True,
                    help="the parameter: t1, t2, slope, speed, hip_angle, u_a, u_r, kappa, or any section.field")
@@ -380,7 +380,7 @@ def settings_from_args(args: argparse.Namespace) -> BifurcationSettings:
     if args.policy is not None:
         if args.t1 is not None or args.t2 is not None:
             raise ParameterError("give either --policy or --t1/--t2, not both")
-        from drake_biped.experiments.options import policy_window
+        from drake_biped.common.options import policy_window
 
         t1, t2 = policy_window(Path(args.policy))
         config = config.override({"window.start_s": t1, "window.end_s": t2})
@@ -396,7 +396,7 @@ def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     settings = settings_from_args(args)
     out = Path(args.out)
-    from drake_biped.experiments.options import cluster
+    from drake_biped.common.options import cluster
 
     with cluster(args) as client:
         record = run(settings, out, client)

@@ -20,7 +20,7 @@ from typing import Any
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.learner_comparison import RUNNING, best_walking_window, compare
 from drake_biped.analysis.series import cmt_change
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
     check_learning_size,
@@ -105,8 +105,8 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
     .png into `out`; return the record."""
     check_settings(settings, CompareSettings, "compare_learners.run")
     from drake_biped.analysis.figures import learner_comparison_figure
+    from drake_biped.common.executor import client_or_local
     from drake_biped.experiments import learning
-    from drake_biped.experiments.executor import client_or_local
 
     out = Path(out)
     wmap = settings.read_map()

@@ -22,7 +22,7 @@ import numpy as np
 
 from drake_biped.analysis import floquet as fq
 from drake_biped.analysis.return_map import complex_list
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
     check_size,
@@ -102,7 +102,7 @@ class FloquetSettings:
 def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
     """A batch evaluator of the step map on `client`: the points split evenly over its workers."""
     from drake_biped.analysis.step_map import evaluate_task
-    from drake_biped.experiments.executor import DrakeGuarded
+    from drake_biped.common.executor import DrakeGuarded
 
     workers = max(1, len(client.scheduler_info()["workers"]))
 
@@ -352,7 +352,7 @@ def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
     """Compute on `client` (a LocalCluster when None); write floquet.json, floquet.md, floquet.png into
     `out`. The record."""
     check_settings(settings, FloquetSettings, "floquet.run")
-    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.common.executor import client_or_local
 
     out = Path(out)
     with client_or_local(client) as c:

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     MAX_CANDIDATES,
     MAX_WALKS,
     add_episode_options,
@@ -779,7 +779,7 @@ def _search_start(settings: GaitSearchSettings) -> EpisodeConfig:
 
 def _score_start(c, settings: GaitSearchSettings, start: EpisodeConfig, windows, log: Path, **extra) -> float:
     """Generation 0: score the start on the cluster and log it with the search's settings; its score."""
-    from drake_biped.experiments.executor import DrakeGuarded
+    from drake_biped.common.executor import DrakeGuarded
 
     value, detail = c.submit(DrakeGuarded(score), start, windows, settings.objective, settings.policy_draws,
                              pure=False).result()
@@ -815,7 +815,7 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
     """Evolve from settings.config on `client` (a LocalCluster when None); write `search.jsonl` (one line
     per generation) and `best_config.json` (use it with --params); return the best and its score."""
     check_settings(settings, GaitSearchSettings, "gait_search.run")
-    from drake_biped.experiments.executor import client_or_local, map_ordered
+    from drake_biped.common.executor import client_or_local, map_ordered
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -880,7 +880,7 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
     import cma
     import numpy as np
 
-    from drake_biped.experiments.executor import client_or_local, map_ordered
+    from drake_biped.common.executor import client_or_local, map_ordered
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

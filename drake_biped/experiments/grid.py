@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     EPISODE_RECORD_BYTES,
     add_episode_options,
     add_resumable_run_options,
@@ -243,7 +243,7 @@ def run_grid(out: Path, base: EpisodeConfig, axes: list[Axis], client,
     best_params.json and the slice figure; return the grid record."""
     from distributed import as_completed
 
-    from drake_biped.experiments.executor import episode_task
+    from drake_biped.common.executor import episode_task
 
     code = versions()
     out.mkdir(parents=True, exist_ok=True)
@@ -341,8 +341,8 @@ def run(settings: GridSettings, out: Path, client=None, progress: bool = True,
     """Run or finish the grid on `client` (a LocalCluster when None), with a progress bar and the run log
     OUT/run.json; write points.jsonl, grid.csv, grid.json, grid_slices.png, best_params.json. The record."""
     check_settings(settings, GridSettings, "grid.run")
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import RunProgress
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import RunProgress
 
     out = Path(out)
     report = RunProgress(out, workers, scheduler, "grid", "point", bar=progress, command="grid")
@@ -395,7 +395,7 @@ def settings_from_args(args: argparse.Namespace) -> GridSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.progress import check_run_log
+    from drake_biped.common.progress import check_run_log
 
     settings = settings_from_args(args)
     out = Path(args.out)

@@ -11,7 +11,7 @@ from typing import Any
 
 from drake_biped.analysis.landscape import WindowRewards, landscape
 from drake_biped.analysis.series import signed_percent
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     check_memory,
     check_size,
     count,

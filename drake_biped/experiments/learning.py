@@ -39,8 +39,8 @@ from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import measure_text
 from drake_biped.analysis.rewalks import measured_cost
 from drake_biped.analysis.reward import reward
-from drake_biped.experiments.learning_record import best_learned_trial, check_learning_record
-from drake_biped.experiments.options import (
+from drake_biped.common.learning_record import best_learned_trial, check_learning_record
+from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
     check_learning_size,
@@ -273,7 +273,7 @@ def run_learning(
     trials and the number of episodes this call recorded."""
     from distributed import as_completed
 
-    from drake_biped.experiments.executor import episode_task
+    from drake_biped.common.executor import episode_task
 
     out.mkdir(parents=True, exist_ok=True)
     (out / "trials").mkdir(exist_ok=True)
@@ -382,7 +382,7 @@ def _as_measured(row: dict[str, Any]) -> dict[str, Any]:
 def _episode_measure(base: EpisodeConfig, means: list[dict[str, Any]], client) -> dict[str, Any]:
     """The paper's measure beside the long-run one: the gait without a window and each trial's final policy
     mean walked one learning episode's distance (its C_mt over the whole walk, initiation included)."""
-    from drake_biped.experiments.executor import episode_task, map_ordered
+    from drake_biped.common.executor import episode_task, map_ordered
 
     configs = [base.replace(window=TorqueFreeWindow())] + [base.replace(window=window_of((m["t1"], m["t2"])))
                                                           for m in means]
@@ -445,8 +445,8 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
     C_mt is measured from REWALK_M on); None: REWALK_M, or the episodes' own distance when that is under the
     paper's 10 m (a small run). Returns the learning record."""
     from drake_biped.analysis.figures import learning_figures
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import RunProgress
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import RunProgress
 
     out = Path(out)
     record_settings = settings.record() if isinstance(settings, LearningSettings) else settings
@@ -541,7 +541,7 @@ def settings_from_args(args: argparse.Namespace) -> LearningSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.progress import check_run_log
+    from drake_biped.common.progress import check_run_log
 
     record_settings = settings_from_args(args).record()  # validated before a cluster starts
     if args.rewalk_distance is not None:

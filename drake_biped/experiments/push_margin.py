@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
     add_window_options,
@@ -120,7 +120,7 @@ def margin_of(forces: list[float], survived: list[list[bool]]) -> float:
 def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, int], None] | None = None
                 ) -> dict[str, Any]:
     """The survival maps and margins of `settings` on `client`; the record (see the module's text)."""
-    from drake_biped.experiments.executor import episode_task, map_ordered
+    from drake_biped.common.executor import episode_task, map_ordered
 
     base, forces, phases = settings.config, settings.forces, settings.phases
     distance = base.sim.distance_m
@@ -243,8 +243,8 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
     """The survival maps on `client` (a LocalCluster when None); writes push_margin.json, push_margin.md and
     push_margin.png into `out`. The record."""
     check_settings(settings, PushMarginSettings, "push_margin.run")
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import progress_bar
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import progress_bar
 
     out = Path(out)
     code = versions()

@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.long_run import has_long_run
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_resumable_run_options,
     cluster,
 )
@@ -141,7 +141,7 @@ class Reproduction:
         """The default gait's learned torque-free period (t1, t2), where it came from, and the learning record
         it came from: the best learned trial of `learn` (the paper's settings), else of `learn_variant`; else the
         window map's cheapest, else LEVEL_WINDOW (no record)."""
-        from drake_biped.experiments.learning_record import best_learned_trial
+        from drake_biped.common.learning_record import best_learned_trial
 
         for source in ("learn", "learn_variant"):
             path = self.out / source / "learning.json"
@@ -164,7 +164,7 @@ class Reproduction:
 
     def client(self):
         """The reproduction's one client, as a context (it is closed by whoever opened it)."""
-        from drake_biped.experiments.executor import client_or_local
+        from drake_biped.common.executor import client_or_local
 
         return client_or_local(self._client)
 
@@ -217,7 +217,7 @@ class Reproduction:
     def table_iii(self) -> dict:
         """Table III's CPG with the default gait's other gains, from the paper's initiation (the grid runs it
         too; the quick run runs it alone)."""
-        from drake_biped.experiments.executor import run_kept
+        from drake_biped.common.executor import run_kept
 
         config = self.level.replace(cpg=PAPER_CPG, initial=InitialConditions())
 
@@ -231,7 +231,7 @@ class Reproduction:
     def full_run(self) -> dict:
         """The shipped full run's learned windows (and no window) walked again, each against the C_mt the
         full run recorded (resources.full_run_digest)."""
-        from drake_biped.experiments.executor import run_kept
+        from drake_biped.common.executor import run_kept
         from drake_biped.experiments.learning import window_of
         from drake_biped.resources import full_run_digest
 
@@ -304,8 +304,8 @@ class Reproduction:
         return self.experiment("time_step", settings, run)
 
     def grid(self) -> dict:
+        from drake_biped.common.executor import run_kept
         from drake_biped.experiments import grid
-        from drake_biped.experiments.executor import run_kept
 
         p = self.profile
         settings = {"points": p.grid_points, "initiation_points": p.grid_initiation_points,
@@ -615,7 +615,7 @@ def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = Tr
     report.html and report_summary.png; reuses finished experiments and resumes the unfinished one. The
     experiments' summaries."""
     check_settings(settings, ReproduceSettings, "reproduce.run")
-    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.common.executor import client_or_local
 
     out = Path(out)
     check_out(out, settings.profile)
@@ -655,7 +655,7 @@ def settings_from_args(args: argparse.Namespace) -> ReproduceSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.executor import check_cluster_options
+    from drake_biped.common.executor import check_cluster_options
 
     settings = settings_from_args(args)
     profile = settings.profile

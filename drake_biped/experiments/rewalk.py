@@ -16,8 +16,8 @@ from typing import Any
 
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, long_run_of_record
 from drake_biped.analysis.rewalks import CHANGES, KEEP, summary
-from drake_biped.experiments.learning_record import check_learning_record
-from drake_biped.experiments.options import (
+from drake_biped.common.learning_record import check_learning_record
+from drake_biped.common.options import (
     add_cluster_options,
     cluster,
     out_folder,
@@ -62,7 +62,7 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
     """Walk each learned window (`learned`: {"trial", "t1", "t2"}, a policy mean, per trial) and the gait
     without a window, as learned and under each change, `distance_m` each (the long-run C_mt is measured after
     the first 10 m), on the Dask `client`: the `summary` record."""
-    from drake_biped.experiments.executor import episode_task
+    from drake_biped.common.executor import episode_task
 
     plain = config.replace(window=TorqueFreeWindow()).override(
         {"sim.distance_m": distance_m, "sim.max_time_s": max(config.sim.max_time_s, 6.0 * distance_m)})
@@ -119,7 +119,7 @@ def run(settings: RewalkSettings, out: Path, client=None, progress: bool = True)
     """The re-walks of the record's final policy means on `client` (a LocalCluster when None); writes
     rewalk.json and rewalk.md into `out`. The record."""
     from drake_biped.analysis.rewalks import markdown
-    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.common.executor import client_or_local
     from drake_biped.records import write_atomic, write_text_atomic
 
     check_settings(settings, RewalkSettings, "rewalk.run")

@@ -37,8 +37,7 @@ import numpy as np
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.rewalks import CHANGE_WORDS, CHANGES
 from drake_biped.analysis.series import moving_average, period
-from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
     add_window_options,
@@ -49,6 +48,7 @@ from drake_biped.experiments.options import (
     episode_config,
     number,
 )
+from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
 from drake_biped.experiments.rewalk import changed
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
@@ -77,7 +77,7 @@ def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
     """The learner state of a level-ground run's best learned trial (`learning_record.best_learned_trial`), read
     from its record OUT/trials/trial_K.json beside the learning.json; and a description of where it came
     from."""
-    from drake_biped.experiments.learning_record import best_learned_trial
+    from drake_biped.common.learning_record import best_learned_trial
     from drake_biped.records import read_json
 
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
@@ -105,7 +105,7 @@ def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[st
     """Each named configuration walked as learned and under every re-walk change, kept in OUT/checks/
     (NAME.json as learned, NAME.CHANGE.json) and reused when its configuration matches: {name: {change:
     result}}."""
-    from drake_biped.experiments.executor import run_kept
+    from drake_biped.common.executor import run_kept
 
     files = {}
     for name, c in configs.items():
@@ -325,8 +325,8 @@ def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
     """The checks and the online learning on `client` (a LocalCluster when None), with a progress bar and
     OUT/run.json; writes slope.json, report.md, fig8_period.png, fig9_distance.png, checks/, trials/."""
     check_settings(settings, SlopeSettings, "slope.run")
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import RunProgress
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import RunProgress
 
     out = Path(out)
     ground = settings.ground()
@@ -383,7 +383,7 @@ def settings_from_args(args: argparse.Namespace) -> SlopeSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.experiments.progress import check_run_log
+    from drake_biped.common.progress import check_run_log
 
     settings = settings_from_args(args)
     out = Path(args.out)

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.return_map import complex_list, fit_return_map, least_squares_map
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
     add_window_options,
@@ -224,7 +224,7 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
                   jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD) -> dict[str, Any]:
     """Run (or finish) the six cells on Dask, then the finite-difference Jacobian of each condition's step
     map at each kick size, and return the stability record. Finished parts are read back on a rerun."""
-    from drake_biped.experiments.executor import run_kept
+    from drake_biped.common.executor import run_kept
     from drake_biped.records import read_kept, write_atomic
 
     code = versions()  # recorded at the start: the code this process runs
@@ -283,7 +283,7 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = JACOBIAN
     jumps where a touchdown moves across an update; a pair of kicks can land on either side of one, and many
     kicks average them out, as the regression does with pushes. The residual says how large they are.
     """
-    from drake_biped.experiments.executor import episode_task
+    from drake_biped.common.executor import episode_task
 
     if not isinstance(step, int) or step < 2:
         raise ParameterError(f"step {step!r}: must be an integer >= 2")
@@ -348,8 +348,8 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     check_settings(settings, StabilitySettings, "stability.run")
     settings.check_walks_reach()
     from drake_biped.analysis.stability_report import write_stability_outputs
-    from drake_biped.experiments.executor import client_or_local
-    from drake_biped.experiments.progress import progress_bar
+    from drake_biped.common.executor import client_or_local
+    from drake_biped.common.progress import progress_bar
     from drake_biped.records import write_atomic
 
     out = Path(out)

@@ -27,8 +27,8 @@ from pathlib import Path
 from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, has_long_run, long_run_of_record
 from drake_biped.analysis.series import signed_percent
-from drake_biped.experiments.executor import episode_task, map_ordered
-from drake_biped.experiments.options import (
+from drake_biped.common.executor import episode_task, map_ordered
+from drake_biped.common.options import (
     add_clock_option,
     add_cluster_options,
     add_model_option,
@@ -371,7 +371,7 @@ def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = Tru
     """Run the study on `client` (a LocalCluster when None); write time_step_study.json, .md and .png into
     `out`; return the record."""
     check_settings(settings, TimeStepSettings, "time_step.run")
-    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.common.executor import client_or_local
 
     out = Path(out)
     steps = sorted(settings.steps)

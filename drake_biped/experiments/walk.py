@@ -16,7 +16,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import Diagram
 
 from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_episode_options,
     episode_config,
     number,

@@ -18,7 +18,7 @@ import numpy as np
 
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.series import signed_percent
-from drake_biped.experiments.options import (
+from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
     cluster,
@@ -119,7 +119,7 @@ def evaluate_windows(config: EpisodeConfig, windows: list[tuple[float, float]], 
     when the same map runs again."""
     from distributed import as_completed
 
-    from drake_biped.experiments.executor import DrakeGuarded
+    from drake_biped.common.executor import DrakeGuarded
 
     configs = [config.replace(window=TorqueFreeWindow(0.0, 0.0))]
     configs += [config.replace(window=TorqueFreeWindow(t1, t2)) for t1, t2 in windows]
@@ -175,7 +175,7 @@ def run(settings: WindowMapSettings, out: Path, client=None, progress: bool = Tr
     window_map.png into `out`; return the record."""
     check_settings(settings, WindowMapSettings, "window_map.run")
     from drake_biped.analysis.figures import window_map_figure
-    from drake_biped.experiments.executor import client_or_local
+    from drake_biped.common.executor import client_or_local
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -235,7 +235,7 @@ def episode_config(args: argparse.Namespace) -> EpisodeConfig:
 @contextmanager
 def cluster(args: argparse.Namespace):
     """The Dask client of the cluster options: --scheduler ADDR, or a LocalCluster of --workers N."""
-    from drake_biped.experiments.executor import dask_client
+    from drake_biped.common.executor import dask_client
 
     with dask_client(workers=args.workers, scheduler=args.scheduler,
                      force=args.force) as client:  # it checks the options first
@@ -248,7 +248,7 @@ def print_lines(lines) -> None:
 
 def policy_window(path: Path) -> tuple[float, float]:
     """The learned torque-free period of a learning.json (`learning_record.best_learned_trial`)."""
-    from drake_biped.experiments.learning_record import best_learned_trial
+    from drake_biped.common.learning_record import best_learned_trial
     from drake_biped.records import read_json
 
     row = best_learned_trial(read_json(path, "--policy"), f"--policy {path}")
@@ -329,7 +329,7 @@ def add_window_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_cluster_options(p: argparse.ArgumentParser) -> None:
-    from drake_biped.experiments.executor import MAX_LOCAL_WORKERS_PER_CORE
+    from drake_biped.common.executor import MAX_LOCAL_WORKERS_PER_CORE
 
     p.add_argument("--workers", type=count, default=None,
                    help=f"local Dask workers (default: one per core; at most {MAX_LOCAL_WORKERS_PER_CORE} per core "
