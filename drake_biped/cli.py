@@ -1,7 +1,7 @@
 """Command-line interface: `drake-biped COMMAND`, one command per experiment module plus `figures`.
 
 Each experiment in EXPERIMENT_COMMANDS owns its command: it declares its options (`add_arguments`, with the
-shared ones of `experiments.options`), builds its settings from them and calls its own `run(settings, out,
+shared ones of `common.options`), builds its settings from them and calls its own `run(settings, out,
 client)`, which writes every file (`command`). This module is the loop over them and what every command shares:
 one line and an exit code for every failure, one run per output folder (records.claim_folder), sizes bounded
 before any work, and `--version`.
