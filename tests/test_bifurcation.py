@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from drake_biped.common.walks import attractor_of_walk
 from drake_biped.episode import run_episode
 from drake_biped.experiments import bifurcation
 from drake_biped.params import EpisodeConfig, ParameterError
@@ -24,13 +25,13 @@ def _walk(periods, com_step=0.2, fell=False, distance=None):
 
 def test_the_transient_is_dropped_and_the_rest_labelled():
     periods = np.concatenate([np.full(20, 0.6), np.tile([0.41, 0.47], 30)])  # 4 m of transient, then period-2
-    label = bifurcation.attractor_of_walk(_walk(periods), distance_m=1.0, transient_m=4.0)
+    label = attractor_of_walk(_walk(periods), distance_m=1.0, transient_m=4.0)
     assert label["first_kept_step"] == 20
     assert label["step_periods_s"] == pytest.approx(periods[20:])
     assert label["attractor"] == "period-2" and label["period"] == 2
     # the long-run C_mt of the kept steps: 10 J per 0.2 m step, m g d = 10 * 9.81 * 0.2
     assert label["cost_of_transport"] == pytest.approx(10.0 / (10.0 * 9.81 * 0.2))
-    short = bifurcation.attractor_of_walk(_walk(periods, distance=3.0), distance_m=5.0, transient_m=4.0)
+    short = attractor_of_walk(_walk(periods, distance=3.0), distance_m=5.0, transient_m=4.0)
     assert short["fell"] and short["attractor"] == "fell" and short["cost_of_transport"] is None
 
 

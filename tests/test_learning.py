@@ -8,7 +8,8 @@ import pytest
 
 from drake_biped.cli import main
 from drake_biped.common.executor import dask_client
-from drake_biped.experiments.learning import Trial, make_settings, reward, run_learning, trial_seed, window_of
+from drake_biped.common.walks import window_of
+from drake_biped.experiments.learning import Trial, make_settings, reward, run_learning, trial_seed
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
 
 

@@ -1,5 +1,5 @@
 """Where walks from different starts end (`drake-biped basins`): a slice of initial conditions (the initiation's
-hip angle x its speed), each start walked long and read by what it settles on (`bifurcation.attractor_of_walk`:
+hip angle x its speed), each start walked long and read by what it settles on (`common.walks.attractor_of_walk`:
 period-k, irregular, or a fall), with and without a torque-free window. Coexisting gaits show as regions of
 different attractors, or of different step periods, in the same slice. Walks are kept in `walks/` as each
 finishes: a rerun of the same command resumes.
@@ -27,8 +27,13 @@ from drake_biped.common.options import (
     number,
     out_folder,
 )
-from drake_biped.experiments.bifurcation import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
-from drake_biped.experiments.stability import CONDITIONS, condition_window
+from drake_biped.common.walks import (
+    CONDITIONS,
+    JITTER_MAX_PERIOD,
+    JITTER_TOLERANCE_S,
+    attractor_of_walk,
+    condition_window,
+)
 from drake_biped.params import LEARNED_WINDOW_S, EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions

@@ -35,7 +35,7 @@ from drake_biped.analysis.attractor import (
     step_period_label,
 )
 from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
-from drake_biped.analysis.long_run import TRANSIENT_M, long_run_cost
+from drake_biped.analysis.long_run import TRANSIENT_M
 from drake_biped.common.options import (
     EPISODE_RECORD_BYTES,
     add_cluster_options,
@@ -46,26 +46,20 @@ from drake_biped.common.options import (
     number,
     out_folder,
 )
+from drake_biped.common.walks import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
 from drake_biped.params import (
-    GRAVITY_MPS2,
     EpisodeConfig,
     ParameterError,
     check_settings,
     resolve_field,
-    walked_the_distance,
 )
 from drake_biped.records import save_figure, write_atomic, write_text_atomic
 from drake_biped.versions import versions
 
-__all__ = ["BifurcationSettings", "attractor_of_walk", "markdown", "premise", "run", "walked_up_to"]
+__all__ = ["BifurcationSettings", "markdown", "premise", "run", "walked_up_to"]
 
 # At most this many walks without --force.
 MAX_WALKS = 400
-# The step periods of a regular gait jitter by a few ms (the controller sees a touchdown at its next update):
-# the tolerance of the reading at that scale, and the longest period it names (every k-th of 20 periods is too
-# few to tell a period-4 at 10 ms from an irregular walk).
-JITTER_TOLERANCE_S = 0.01
-JITTER_MAX_PERIOD = 2
 # The neighbour walk of an irregular one: its swing hip's rate kicked by this much (rad/s), this long after the
 # first kept touchdown (the swing foot in the air); their sections' distance followed until it reaches this
 # fraction of the attractor's spread.
@@ -135,26 +129,6 @@ def point_config(settings: BifurcationSettings, value: float, time_step_s: float
     return config
 
 
-def attractor_of_walk(result: dict[str, Any], distance_m: float, transient_m: float = TRANSIENT_M,
-                      window: int = PERIOD_WINDOW, tolerance_s: float = PERIOD_TOLERANCE_S) -> dict[str, Any]:
-    """What a walk (an episode's result dictionary) settled on: its steps after the transient (step periods,
-    section states), the attractor they show (analysis.attractor.step_period_label: "period-k", "irregular",
-    "fell", or "too short" when the walk kept too few steps), and its long-run C_mt with the 95 % interval."""
-    steps = result["steps"]
-    times = np.array([s["touchdown_time_s"] for s in steps], dtype=float)
-    com = np.array([s["com_x_m"] for s in steps], dtype=float)
-    work = np.array([math.nan if s["positive_work_j"] is None else s["positive_work_j"] for s in steps], dtype=float)
-    fell = not walked_the_distance(result["fell"], result["distance_m"], distance_m)
-    first = int(np.searchsorted(com - com[0], transient_m, side="left")) if len(com) else 0
-    periods = np.diff(times[first:])
-    sections = [[s["hip_angle_rad"], s["hip_rate_radps"]] for s in steps[first + 1:]]
-    label = step_period_label(periods, fell=fell, window=window, tolerance_s=tolerance_s)
-    long_run = long_run_cost(times, com, work, result["mass_kg"], GRAVITY_MPS2, transient_m) if not fell else None
-    return {"fell": fell, "fall_reason": result.get("fall_reason") or None, "distance_m": result["distance_m"],
-            "first_kept_step": first, "step_periods_s": [float(t) for t in periods], "sections": sections,
-            **label,
-            "cost_of_transport": None if long_run is None else long_run["cost_of_transport"],
-            "interval_95": None if long_run is None else long_run["interval_95"]}
 
 
 def walked_up_to(points: list[dict[str, Any]]) -> float | None:

@@ -512,7 +512,7 @@ def _steady_push_rows(config: EpisodeConfig, window: tuple[float, float]) -> lis
     of PUSH_FORCE_N at each of SURE_PUSH_PHASES phases of its first step from SURE_SETTLE_S on (`push-margin`'s
     pushes), each row tagged with its force and start; every push counts as a fall when the walk does not walk
     unpushed or has no step after SURE_SETTLE_S."""
-    from drake_biped.experiments.push_margin import steady_step
+    from drake_biped.common.walks import steady_step
     from drake_biped.paper import PUSH_DURATION_S
     from drake_biped.params import Push
 

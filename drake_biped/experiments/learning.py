@@ -50,7 +50,8 @@ from drake_biped.common.options import (
     number,
     print_lines,
 )
-from drake_biped.experiments.rewalk import REWALK_M, rewalk, window_of
+from drake_biped.common.walks import window_of
+from drake_biped.experiments.rewalk import REWALK_M, rewalk
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.registry import learner_from_state, make_learner
 from drake_biped.paper import (

@@ -31,7 +31,7 @@ from drake_biped.common.options import (
     number,
     out_folder,
 )
-from drake_biped.experiments.stability import CONDITIONS, condition_window
+from drake_biped.common.walks import CONDITIONS, condition_window, steady_step
 from drake_biped.paper import PUSH_DURATION_S
 from drake_biped.params import (
     LEARNED_WINDOW_S,
@@ -90,13 +90,6 @@ class PushMarginSettings:
         return 2 * len(self.forces) * 2 * self.phases
 
 
-def steady_step(result: dict[str, Any], settle_s: float) -> tuple[float, float] | None:
-    """(T_k, T_k+1): the first whole step of an unpushed walk that starts at or after `settle_s`."""
-    times = [s["touchdown_time_s"] for s in result["steps"]]
-    for a, b in zip(times, times[1:]):
-        if a >= settle_s:
-            return a, b
-    return None
 
 
 def margin_text(cell: dict[str, Any]) -> str:

@@ -232,7 +232,7 @@ class Reproduction:
         """The shipped full run's learned windows (and no window) walked again, each against the C_mt the
         full run recorded (resources.full_run_digest)."""
         from drake_biped.common.executor import run_kept
-        from drake_biped.experiments.learning import window_of
+        from drake_biped.common.walks import window_of
         from drake_biped.resources import full_run_digest
 
         digest = full_run_digest()

@@ -22,6 +22,7 @@ from drake_biped.common.options import (
     cluster,
     out_folder,
 )
+from drake_biped.common.walks import window_of
 from drake_biped.params import (
     GRAVITY_MPS2,
     EpisodeConfig,
@@ -36,13 +37,9 @@ from drake_biped.versions import versions
 # A re-walk's length: the initiation's transient, then the long-run mean's span.
 REWALK_M = TRANSIENT_M + LONG_RUN_M
 
-__all__ = ["RewalkSettings", "changed", "rewalk", "rewalk_record", "run", "window_of"]
+__all__ = ["RewalkSettings", "changed", "rewalk", "rewalk_record", "run"]
 
 
-def window_of(sample) -> TorqueFreeWindow:
-    """The window a learner's sample (t1, t2) walks: times below 0 act as 0, above 10 s as 10 s."""
-    t1, t2 = (max(0.0, min(float(x), 10.0)) for x in sample)
-    return TorqueFreeWindow(t1, t2)
 
 
 def changed(config: EpisodeConfig, change: str) -> EpisodeConfig:

@@ -39,6 +39,7 @@ from drake_biped.common.options import (
     episode_config,
     number,
 )
+from drake_biped.common.walks import CONDITIONS, condition_window
 from drake_biped.paper import TABLE_VI
 from drake_biped.params import (
     LEARNED_WINDOW_S,
@@ -46,12 +47,10 @@ from drake_biped.params import (
     InitialConditions,
     ParameterError,
     Push,
-    TorqueFreeWindow,
     check_settings,
 )
 from drake_biped.versions import versions
 
-CONDITIONS = ("without", "with")
 DISTURBANCES = ("undisturbed", "forward", "backward")
 
 TABLE_VI_PAPER = TABLE_VI  # eigenvalues of the return map, as (real, imaginary) pairs
@@ -121,9 +120,6 @@ class StabilitySettings:
         return d
 
 
-def condition_window(condition: str, window: tuple[float, float]) -> TorqueFreeWindow:
-    """The torque-free window of a condition: `window` "with", none "without"."""
-    return TorqueFreeWindow(*window) if condition == "with" else TorqueFreeWindow(0.0, 0.0)
 
 
 def trial_initial(base: InitialConditions, seed: int, trial: int, spread: float) -> InitialConditions:
