@@ -1,5 +1,5 @@
 """Learned torque-free periods re-walked where the learner did not walk them (the record's summary and report;
-the walks: `drake_biped.experiments.rewalk`).
+the walks: `drake_biped.common.walks.rewalk`).
 
 A walk's saving is 1 - C_mt(window) / C_mt(no window) under the same change, each the walk's long-run C_mt
 (analysis.long_run: the walks are 110 m, the first 10 m dropped) where the record has it, else the episode's

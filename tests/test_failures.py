@@ -279,11 +279,11 @@ def _api_cases():
     import numpy as np
 
     import drake_biped as db
+    from drake_biped.common.learning_runs import LearningSettings
     from drake_biped.experiments.bifurcation import BifurcationSettings
     from drake_biped.experiments.gait_search import GaitSearchSettings
     from drake_biped.experiments.grid import Axis, GridSettings
     from drake_biped.experiments.landscape import LandscapeSettings
-    from drake_biped.experiments.learning import LearningSettings
     from drake_biped.experiments.stability import StabilitySettings
     from drake_biped.experiments.time_step import TimeStepSettings
     from drake_biped.experiments.window_map import WindowMapSettings

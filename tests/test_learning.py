@@ -8,8 +8,8 @@ import pytest
 
 from drake_biped.cli import main
 from drake_biped.common.executor import dask_client
+from drake_biped.common.learning_runs import Trial, make_settings, reward, run_learning, trial_seed
 from drake_biped.common.walks import window_of
-from drake_biped.experiments.learning import Trial, make_settings, reward, run_learning, trial_seed
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
 
 
@@ -78,7 +78,7 @@ def test_draws_without_a_window_are_walked_once_and_give_each_trial_that_walks_r
                                                                                    monkeypatch):
     """Every draw with t2 <= t1 walks the same episode: one walk serves them all, and the trials' records are
     those of walking every draw, to the byte."""
-    from drake_biped.experiments import learning
+    from drake_biped.common import learning_runs as learning
 
     settings = _settings(episodes=6, trials=2)
     once = _CountingClient(client)
@@ -99,7 +99,7 @@ def test_draws_without_a_window_are_walked_once_and_give_each_trial_that_walks_r
 def test_a_shorter_run_is_replayed_from_a_longer_ones_records(tmp_path, client):
     """The records of a 1 x 3 run, replayed from a 1 x 5 run of the same settings, are the 1 x 3 run's own
     to the byte; other settings, or a record the learner cannot have drawn, give none."""
-    from drake_biped.experiments.learning import replay_run
+    from drake_biped.common.learning_runs import replay_run
 
     short, long_ = _settings(episodes=3, trials=1), _settings(episodes=5, trials=1)
     run_learning(tmp_path / "short", short, client)
@@ -216,7 +216,7 @@ def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client)
     config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     window_map.run(window_map.WindowMapSettings(config, t1_max_s=0.1, t2_max_s=0.3), tmp_path / "map", client,
                    progress=False)
-    from drake_biped.experiments import learning
+    from drake_biped.common import learning_runs as learning
 
     longer = learning.run(learning.LearningSettings(config, trials=1, episodes=5), tmp_path / "learn", client,
                           progress=False)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from drake_biped.analysis.rewalks import CHANGES, HOLD_SAVING, headline, markdown, summary
-from drake_biped.experiments.rewalk import changed
+from drake_biped.common.walks import changed
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
 
 
@@ -66,7 +66,7 @@ def test_the_rewalk_command_repeats_a_learning_runs_own_rewalks(tmp_path, client
     """A learning run re-walks its final policy means; `drake-biped rewalk --policy` on its record gets the
     same numbers, the walks as learned are Table V's, and halving the step changes the walk."""
     from drake_biped.cli import main
-    from drake_biped.experiments import learning
+    from drake_biped.common import learning_runs as learning
 
     config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     settings = learning.LearningSettings(config, trials=1, episodes=2, mean=(0.1, 0.4), variance=1e-6)

@@ -1,11 +1,11 @@
 """Learners side by side (`drake-biped compare-learners`): each learner over the same trials x episodes of
 the same gait from the same start, against the window map's best walking window (the known optimum), and
 each learner's final windows re-walked with the plant step halved and from a nudged start
-(`drake_biped.experiments.rewalk`).
+(`drake_biped.common.walks.rewalk`).
 
 Each learner's run is an ordinary learning run in OUT/NAME/ (the same records, figures and resume as
 `drake-biped learn --learner NAME`); a learner given in `reuse` with a longer run of the same settings (the
-paper's GARB run of `learn`, say) takes that run's first episodes (`learning.replay_run`) instead of walking
+paper's GARB run of `learn`, say) takes that run's first episodes (`learning_runs.replay_run`) instead of walking
 them again; OUT/compare.json, compare.md and compare.png put them side by side
 (`drake_biped.analysis.learner_comparison`). Rerunning the same command resumes every unfinished run.
 """
@@ -85,7 +85,7 @@ class CompareSettings:
 
 
 def _learning_settings(settings: CompareSettings, name: str):
-    from drake_biped.experiments.learning import LearningSettings
+    from drake_biped.common.learning_runs import LearningSettings
 
     return LearningSettings(settings.config, settings.trials, settings.episodes, settings.seed,
                             mean=tuple(settings.mean), variance=settings.variance, learner=name)
@@ -93,11 +93,11 @@ def _learning_settings(settings: CompareSettings, name: str):
 
 def check(settings: CompareSettings, out: Path) -> None:
     """Everything a run would refuse, before a cluster starts: the map, the learners, damaged records."""
-    from drake_biped.experiments import learning
+    from drake_biped.common import learning_runs
 
     settings.read_map()
     for name in settings.learners:
-        learning.check_resume(_learning_settings(settings, name).record(), Path(out) / name)
+        learning_runs.check_resume(_learning_settings(settings, name).record(), Path(out) / name)
 
 
 def run(settings: CompareSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
@@ -105,8 +105,8 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
     .png into `out`; return the record."""
     check_settings(settings, CompareSettings, "compare_learners.run")
     from drake_biped.analysis.figures import learner_comparison_figure
+    from drake_biped.common import learning_runs
     from drake_biped.common.executor import client_or_local
-    from drake_biped.experiments import learning
 
     out = Path(out)
     wmap = settings.read_map()
@@ -119,8 +119,8 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
         for name in settings.learners:
             learn_settings = _learning_settings(settings, name).record()
             source = settings.reuse.get(name)
-            replayed = source is not None and learning.replay_run(Path(source), out / name, learn_settings)
-            record = learning.run(learn_settings, out / name, c, progress=progress)
+            replayed = source is not None and learning_runs.replay_run(Path(source), out / name, learn_settings)
+            record = learning_runs.run(learn_settings, out / name, c, progress=progress)
             wall = read_json(out / name / "run.json", "compare-learners")["learning_wall_s"]
             rows[name] = {**compare(record, best), "wall_s": wall, "replayed_from": source if replayed else None}
             curves[name] = [t["episodes"] for t in record["trials"]]

@@ -338,14 +338,14 @@ class Reproduction:
 
     def _learn(self, name: str, trials: int, episodes: int, mean, variance: float,
                config: EpisodeConfig | None = None) -> dict:
-        from drake_biped.experiments import learning
+        from drake_biped.common import learning_runs
 
-        settings = learning.LearningSettings(config or self.level, trials, episodes, 0, mean=mean,
+        settings = learning_runs.LearningSettings(config or self.level, trials, episodes, 0, mean=mean,
                                              variance=variance).record()
         distance = self.profile.rewalk_distance_m
 
         def run(folder: Path) -> dict:
-            record = learning.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler,
+            record = learning_runs.run(settings, folder, self._client, workers=self.workers, scheduler=self.scheduler,
                                   rewalk_distance_m=distance)
             ev = record["evaluation"]
             run_log = read_json(folder / "run.json", "reproduce")

@@ -10,7 +10,7 @@ episodes on that ground:
    climbs? (`trials` independent runs of `episodes` each; then each final policy mean)
 
 Each answer is walked four times: as learned, with the plant step halved, and from 0.95 and 1.05 x the
-initiation speed (`drake_biped.experiments.rewalk`); a claim holds only when it holds in all four (a walk that
+initiation speed (`drake_biped.common.walks.rewalk`); a claim holds only when it holds in all four (a walk that
 climbs only in one simulation, from one start, does not climb).
 
 The learner starts from the learned policy's state: its mean, variance and eligibility trace. The paper
@@ -19,7 +19,7 @@ ground, so α_p follows Table II from its first band (carrying the count over wo
 a 500-episode level run, and the period could not move in tens of episodes), and the baseline becomes the
 running mean of the slope's rewards. Reward and fall rule are the level run's (`analysis.reward`).
 
-Nothing lost: the learning runs through `learning.run_learning` (each trial's record rewritten after every
+Nothing lost: the learning runs through `common.learning_runs.run_learning` (each trial's record rewritten after every
 episode, resumed on rerun) and the check episodes are kept in OUT/checks/ and reused.
 """
 
@@ -37,6 +37,7 @@ import numpy as np
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.rewalks import CHANGE_WORDS, CHANGES
 from drake_biped.analysis.series import moving_average, period
+from drake_biped.common.learning_runs import make_settings, run_learning, trial_seed
 from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
@@ -48,8 +49,7 @@ from drake_biped.common.options import (
     episode_config,
     number,
 )
-from drake_biped.experiments.learning import make_settings, run_learning, trial_seed, window_of
-from drake_biped.experiments.rewalk import changed
+from drake_biped.common.walks import changed, window_of
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
 from drake_biped.params import (
