@@ -291,7 +291,7 @@ def test_floquet_command_writes_its_record(tmp_path):
     assert "the phase of the 1 ms control update" in (out / "floquet.md").read_text()  # the default gait's period
     # the stability report's section (`stability --floquet`) carries the same text, headings one level down
     from drake_biped.analysis.stability_report import _floquet_sections
-    from drake_biped.experiments import floquet
+    from drake_biped.common import floquet_runs as floquet
 
     section = "\n".join(_floquet_sections({"floquet": {"without": {"markdown": floquet.markdown(record)}}}))
     assert "#### Floquet multipliers of the periodic orbit (no torque-free period)" in section
@@ -307,7 +307,7 @@ def test_the_attracting_gait_has_an_attracting_orbit():
     on): there its period-1 orbit's multipliers, by the searches' one-process Newton and Jacobian
     (`orbit_radius`), lie inside the unit circle (0.08). On the contact with a continuous limit Newton finds no
     period-1 orbit (residual 0.011) and its step periods alternate by about 2 ms: docs/RESULTS.md."""
-    from drake_biped.experiments.floquet import orbit_radius
+    from drake_biped.common.floquet_runs import orbit_radius
     from drake_biped.params import DRAKE_DEFAULT_CONTACT
     from drake_biped.resources import load_gait
 
@@ -320,7 +320,7 @@ def test_the_decay_check_stays_inside_the_linear_range():
     """A growing mode gets a perturbation small enough that J^k delta stays below the plateau's top; a
     decaying one the plateau's top (the largest still linear, the furthest above rounding); a sweep without
     a plateau the settings' size; never below the floor."""
-    from drake_biped.experiments.floquet import FloquetSettings, decay_size
+    from drake_biped.common.floquet_runs import FloquetSettings, decay_size
 
     settings = FloquetSettings(decay_size=1e-6, decay_floor=1e-12, decay_steps=5)
     plateau = {"plateau": [1e-8, 3e-5]}
@@ -334,7 +334,7 @@ def test_the_decay_check_stays_inside_the_linear_range():
 def test_floquet_reports_the_period_the_map_settles_on():
     """A map whose attractor is the logistic map's period-2 orbit at r = 3.2 (the 2-fold map's multiplier
     4 + 2r - r^2 = 0.16), beside a coordinate the section normal marks trivial; then one with no period."""
-    from drake_biped.experiments.floquet import FloquetSettings, orbit_period
+    from drake_biped.common.floquet_runs import FloquetSettings, orbit_period
 
     def logistic(r):
         def evaluate(points):

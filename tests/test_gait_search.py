@@ -223,7 +223,7 @@ def test_floquet_objective_rewards_an_attracting_orbit(monkeypatch):
     that did not converge, and a walker whose orbit cannot be linearised between every walker and every
     faller."""
     from drake_biped.analysis.floquet import StepFailed
-    from drake_biped.experiments import floquet
+    from drake_biped.common import floquet_runs as floquet
 
     monkeypatch.setattr(gait_search, "_walk", lambda config: {"walked": True, "cost_of_transport": 0.2,
                                                               "distance_m": 6.0, "reward": 5.0})

@@ -396,7 +396,7 @@ class Reproduction:
                                                "distance_m": 12.0}, run)
 
     def floquet(self) -> dict:
-        from drake_biped.experiments import floquet
+        from drake_biped.common import floquet_runs as floquet
 
         windows = {"none": (0.0, 0.0)}
         if "learned" in self.profile.floquet_gaits:

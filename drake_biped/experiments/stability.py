@@ -339,7 +339,7 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
     """The six cells and the Jacobians of the settings' gait (the default gait when None) on `client` (a
     LocalCluster when None), with a progress bar; writes episodes/, stability.json, fig7_return_map.png,
     report.md and report.html into `out`. `settings.floquet`: also the periodic orbit's Floquet multipliers
-    without and with the window (experiments/floquet.py; floquet_without/, floquet_with/ and a report
+    without and with the window (common/floquet_runs.py; floquet_without/, floquet_with/ and a report
     section). The record."""
     check_settings(settings, StabilitySettings, "stability.run")
     settings.check_walks_reach()
@@ -362,9 +362,9 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
 
 
 def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, client) -> dict[str, Any]:
-    """The Floquet analysis (experiments/floquet.py) without and with the window, into floquet_CONDITION/;
+    """The Floquet analysis (common/floquet_runs.py) without and with the window, into floquet_CONDITION/;
     what the report shows of each."""
-    from drake_biped.experiments import floquet
+    from drake_biped.common import floquet_runs as floquet
 
     found = {}
     for condition in CONDITIONS:

@@ -1,0 +1,364 @@
+"""The gait's periodic orbit and its Floquet multipliers through Drake (`drake-biped floquet`).
+
+The full-state step map on the mid-stance section (analysis/step_map.py) is evaluated on Dask: the fixed
+point by Newton's method from the steady walk, the central-difference Jacobian for a sweep of the
+perturbation over several decades, the multipliers at the converged ε with their eigenvectors by name, and
+two cross-checks: the linearisation's prediction of a small perturbation's next steps against the map
+iterated, and against the simulation continued without restarting (the controller is a sampled-data
+system: the map restarts the 1 ms update grid at the section, a continued walk keeps its own grid phase, and
+the difference between them is measured as the gait's sensitivity to the sampling phase).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drake_biped.analysis import floquet as fq
+from drake_biped.analysis.return_map import complex_list
+from drake_biped.common.options import (
+    check_size,
+)
+from drake_biped.params import EpisodeConfig, ParameterError, check_settings, clock_of_record
+from drake_biped.records import write_atomic, write_text_atomic
+from drake_biped.versions import versions
+
+__all__ = ["FloquetSettings", "analyse", "markdown", "run"]
+
+DEFAULT_EPSILONS = tuple(float(10.0 ** e) for e in np.arange(-8.0, -2.49, 0.5))
+
+
+# The most step-map evaluations of one kind a Floquet run is given (settling steps, Newton's iterations, the
+# transient of the period search, the decay check), and the most perturbation sizes swept (each a Jacobian).
+MAX_MAP_STEPS = 1000
+MAX_EPSILONS = 40
+
+
+@dataclass(frozen=True)
+class FloquetSettings:
+    """The gait (its window included), the start of the search, the perturbation sweep and the checks."""
+
+    config: EpisodeConfig = field(default_factory=EpisodeConfig)
+    settle_steps: int = 8
+    epsilons: tuple[float, ...] = DEFAULT_EPSILONS
+    newton_epsilon: float = 1e-6
+    newton_tolerance: float = fq.NEWTON_TOLERANCE
+    newton_iterations: int = 6
+    plateau_tolerance: float = 0.05
+    decay_steps: int = 5
+    # The perturbation of the decay check (`decay_size()`): the largest that keeps J^k delta inside the
+    # sweep's plateau (the linear range) over the decay_steps; decay_size without a plateau; at least
+    # decay_floor.
+    decay_size: float = 1e-6
+    decay_floor: float = 1e-10
+    # The orbit's period: the map iterated period_transient times from the settled section, then the smallest
+    # k <= 8 with which its iterates repeat to within period_tolerance (relative; `floquet.periodic_orbit`).
+    period_transient: int = 60
+    period_tolerance: float = 1e-6
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.settle_steps, int) or self.settle_steps < 1:
+            raise ParameterError(f"settle_steps {self.settle_steps!r}: must be an integer >= 1")
+        if len(self.epsilons) < 3 or any(not (math.isfinite(e) and e > 0) for e in self.epsilons):
+            raise ParameterError(f"epsilons {self.epsilons!r}: need at least three positive sizes")
+        for name in ("newton_epsilon", "newton_tolerance", "plateau_tolerance", "decay_size", "decay_floor"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ParameterError(f"{name} {value!r}: must be a positive number")
+        if not isinstance(self.decay_steps, int) or self.decay_steps < 1:
+            raise ParameterError(f"decay_steps {self.decay_steps!r}: must be an integer >= 1")
+        for name in ("newton_iterations", "period_transient"):
+            if not isinstance(getattr(self, name), int) or getattr(self, name) < 0:
+                raise ParameterError(f"{name} {getattr(self, name)!r}: must be an integer >= 0")
+        # every one of these is a walk of steps (each a step map's evaluation, 2 x 14 per Jacobian)
+        check_size(f"--settle-steps {self.settle_steps}", self.settle_steps, MAX_MAP_STEPS, "steps", None)
+        check_size(f"--epsilons ({len(self.epsilons)} sizes)", len(self.epsilons), MAX_EPSILONS, "Jacobians", None)
+        for name in ("newton_iterations", "period_transient", "decay_steps"):
+            check_size(f"{name} {getattr(self, name)}", getattr(self, name), MAX_MAP_STEPS, "steps", None)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"settle_steps": self.settle_steps, "epsilons": list(self.epsilons),
+                "newton_epsilon": self.newton_epsilon, "newton_tolerance": self.newton_tolerance,
+                "newton_iterations": self.newton_iterations, "plateau_tolerance": self.plateau_tolerance,
+                "decay_steps": self.decay_steps, "decay_size": self.decay_size, "decay_floor": self.decay_floor,
+                "period_transient": self.period_transient, "period_tolerance": self.period_tolerance}
+
+
+def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
+    """A batch evaluator of the step map on `client`: the points split evenly over its workers."""
+    from drake_biped.analysis.step_map import evaluate_task
+    from drake_biped.common.executor import DrakeGuarded
+
+    workers = max(1, len(client.scheduler_info()["workers"]))
+
+    def evaluate(points):
+        points = [np.asarray(p, dtype=float).tolist() for p in points]
+        size = max(1, math.ceil(len(points) / (2 * workers)))
+        chunks = [points[i : i + size] for i in range(0, len(points), size)]
+        futures = [client.submit(DrakeGuarded(evaluate_task), config, template, chunk, pure=False)
+                   for chunk in chunks]
+        out = []
+        for part in client.gather(futures):
+            out.extend(None if y is None else np.array(y) for y in part)
+        return out
+
+    return evaluate
+
+
+def decay_size(settings: FloquetSettings, plateau: dict[str, Any], radius: float) -> float:
+    """The decay check's perturbation: the largest for which the map is still linear over the check, so
+    that the deviations stay above the map's rounding for as long as they can: the top of the plateau,
+    divided by radius**decay_steps when the mode grows (so the deviation stays below it for
+    settings.decay_steps steps); settings.decay_size without a plateau; never below settings.decay_floor."""
+    size = settings.decay_size
+    if plateau.get("plateau"):
+        size = plateau["plateau"][1] / max(1.0, radius) ** settings.decay_steps
+    return max(size, settings.decay_floor)
+
+
+def orbit_radius(config: EpisodeConfig, settle_steps: int = 8, epsilon: float = 1e-6,
+                 iterations: int = 4) -> dict[str, Any]:
+    """The spectral radius of `config`'s period-1 orbit in one process, for searches (no Dask, no sweep):
+    Newton from the section after `settle_steps` touchdowns, then one central-difference Jacobian at
+    `epsilon` at the fixed point. Raises ParameterError when the gait falls before its section, StepFailed
+    when a perturbed step falls."""
+    from drake_biped.analysis.step_map import SectionMap
+
+    section_map = SectionMap(config)
+    z0, template = section_map.start(settle_steps)
+    evaluate = fq.serial(lambda z: section_map.step(z, template))
+    fixed = fq.newton_fixed_point(evaluate, z0, epsilon, tolerance=fq.NEWTON_TOLERANCE,
+                                  max_iterations=iterations)
+    jac = fq.difference_jacobian(evaluate, fixed.state, epsilon)
+    mult = fq.multipliers(jac, section_map.section_normal())
+    return {"spectral_radius": mult.nontrivial_radius(), "fixed_point_residual": fixed.residual}
+
+
+def orbit_period(settings: FloquetSettings, evaluate: fq.Batch, z0: np.ndarray, normal: np.ndarray) -> dict[str, Any]:
+    """The period of the orbit the section map settles on (`floquet.periodic_orbit`): {"period": k, "multipliers"
+    of the k-fold map (non-trivial, [re, im], largest first), "residual", "spread"} or, where no period up to 8
+    repeats, {"period": None, "spread"}; "spread": the largest coordinate range over the last 16 iterates."""
+    def step(z):
+        (y,) = evaluate([z])
+        if y is None:
+            raise fq.StepFailed("the walker falls on the map's iterates")
+        return y
+
+    try:
+        orbit = fq.periodic_orbit(step, z0, transient=settings.period_transient,
+                                  detect_tolerance=settings.period_tolerance, epsilon=settings.newton_epsilon,
+                                  tolerance=settings.newton_tolerance, max_iterations=settings.newton_iterations)
+    except fq.NoPeriodicOrbit as exc:
+        tail = exc.iterates[-16:]
+        return {"period": None, "spread": float(np.max(np.ptp(tail, axis=0)))}
+    except fq.StepFailed as exc:
+        return {"period": None, "spread": None, "error": str(exc)}
+    mult = fq.multipliers(orbit.jacobian, normal)
+    keep = [v for v, t in zip(mult.values, mult.trivial) if t is None]
+    return {"period": orbit.period, "multipliers": complex_list(np.array(keep)), "residual": orbit.residual,
+            "spectral_radius": float(max(abs(v) for v in keep)) if keep else None,
+            "spread": float(np.max(np.ptp(orbit.points, axis=0)))}
+
+
+def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
+    """The fixed point, the sweep, the multipliers and the cross-checks of `settings.config`'s gait."""
+    from drake_biped.analysis.step_map import SectionMap
+
+    wall0 = time.perf_counter()
+    section_map = SectionMap(settings.config)  # raises ParameterError for a ground or push it cannot take
+    z0, template = section_map.start(settings.settle_steps)
+    names = list(section_map.names)
+    cfg, tmpl = settings.config.to_dict(), template.to_dict()
+    evaluate = _batch(client, cfg, tmpl)
+    period = orbit_period(settings, evaluate, z0, section_map.section_normal())
+
+    fixed = fq.newton_fixed_point(evaluate, z0, settings.newton_epsilon, tolerance=settings.newton_tolerance,
+                                  max_iterations=settings.newton_iterations, max_halvings=8)
+    z = fixed.state
+    # The map's own noise on the scale of Newton's last residual (at most 1e-6: a larger residual is no fixed
+    # point whatever the noise): a residual within it is a fixed point found.
+    try:
+        noise = fq.evaluation_noise(evaluate, z, min(max(fixed.residual, settings.newton_tolerance), 1e-6))
+    except fq.StepFailed:
+        noise = None
+    floor = fq.newton_floor(settings.newton_tolerance, noise)
+    sweep = fq.epsilon_sweep(evaluate, z, settings.epsilons)
+    chosen = fq.converged_epsilon(sweep, settings.plateau_tolerance)
+    index = chosen["index"] if chosen["index"] is not None else int(np.argmin(np.abs(
+        np.log10(np.array(settings.epsilons)) - math.log10(settings.newton_epsilon))))
+    jac = sweep[index]["jacobian"]
+    if jac is None:
+        raise RuntimeError("every perturbation of the sweep made the walker fall: the gait has no orbit to linearise")
+    mult = fq.multipliers(jac, section_map.section_normal())
+    dominant = []
+    for k in range(min(4, len(mult.values))):
+        if mult.trivial[k] is None:
+            dominant.append({"multiplier": [float(mult.values[k].real), float(mult.values[k].imag)],
+                             "modulus": float(abs(mult.values[k])),
+                             "components": fq.named_components(mult.vectors[:, k], names)})
+
+    # Cross-checks: a perturbation along the dominant eigenvector (real part), predicted and simulated.
+    lead = next(k for k, t in enumerate(mult.trivial) if t is None)
+    direction = mult.vectors[:, lead].real
+    direction = direction / np.linalg.norm(direction)
+    size = decay_size(settings, chosen, mult.nontrivial_radius())
+    delta = size * direction
+    predicted = fq.predicted_deviations(jac, delta, settings.decay_steps)
+    iterated, pair = [], [z + delta, z]
+    for _ in range(settings.decay_steps):
+        pair = evaluate(pair)
+        if pair[0] is None or pair[1] is None:
+            break
+        iterated.append(pair[0] - pair[1])
+    base_run = section_map.trajectory(z, settings.decay_steps, template)
+    perturbed_run = section_map.trajectory(z + delta, settings.decay_steps, template)
+
+    def norms(rows):
+        return [float(np.linalg.norm(r)) for r in rows]
+
+    decay = {
+        "size": size,
+        "direction": {n: float(v) for n, v in zip(names, direction)},
+        "predicted": norms(predicted),
+        "map_iterated": norms(iterated),
+        "continued": (norms([a - b for a, b in zip(perturbed_run, base_run)])
+                      if perturbed_run and base_run else None),
+    }
+    decay["map_iterated_ratio"] = [m / p for m, p in zip(decay["map_iterated"], decay["predicted"])]
+    if decay["continued"]:
+        decay["continued_ratio"] = [c / p for c, p in zip(decay["continued"], decay["predicted"])]
+    # The sampling phase: the fixed point continued on its own update grid, against the map's restarts.
+    phase = norms([b - z for b in base_run]) if base_run else None
+
+    return {
+        "coordinates": names,
+        "multipliers": complex_list(mult.values),
+        "trivial": mult.trivial,
+        "spectral_radius": mult.spectral_radius,
+        "nontrivial_spectral_radius": mult.nontrivial_radius(),
+        "dominant_modes": dominant,
+        "fixed_point": {n: float(v) for n, v in zip(names, z)},
+        "fixed_point_residual": fixed.residual,
+        "evaluation_noise": noise,
+        "newton_floor": floor,
+        "newton_residuals": fixed.residuals,
+        "newton_iterations": fixed.iterations,
+        "start_residual": fixed.residuals[0],
+        "epsilon_sweep": [{"epsilon": r["epsilon"], "spectral_radius": r["spectral_radius"]} for r in sweep],
+        "converged_epsilon": chosen["epsilon"],
+        "plateau": chosen,
+        "jacobian": jac.tolist(),
+        "decay": decay,
+        "sampling_phase_drift": phase,
+        "template": tmpl,
+        "orbit_period": period,
+        "wall_time_s": time.perf_counter() - wall0,
+    }
+
+
+def _fmt(value: float | None, spec: str = ".4g") -> str:
+    return "—" if value is None else format(value, spec)
+
+
+def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the periodic orbit") -> str:
+    """floquet.md: the multipliers, the sweep, the modes and the cross-checks."""
+    window = record["config"]["window"]
+    has_window = window["end_s"] > window["start_s"]
+    gait = f"torque-free period {window['start_s']:.3f}–{window['end_s']:.3f} s" if has_window else "no torque-free period"
+    lines = [f"### {title} ({gait})", "",
+             f"Full-state step map on the mid-stance section ({len(record['coordinates'])} coordinates), "
+             f"central differences through Drake. Fixed point by Newton: residual "
+             f"{record['start_residual']:.2e} → **{record['fixed_point_residual']:.2e}** (relative) in "
+             f"{record['newton_iterations']} iterations"
+             + (f"; the map's own evaluation noise there {record['evaluation_noise']:.1e}, so Newton's floor "
+                f"{record['newton_floor']:.1e}." if record.get("evaluation_noise") is not None else "."), ""]
+    p = record["plateau"]
+    if p["epsilon"] is not None:
+        lines.append(f"Converged ε = **{p['epsilon']:.1e}** (spectral radius within "
+                     f"{100 * p['max_change']:.2f} % over {p['plateau'][0]:.0e}–{p['plateau'][1]:.0e}, "
+                     f"{p['decades']:.1f} decades).")
+    else:
+        lines.append("No two neighbouring perturbation sizes agree: the Jacobian did not converge.")
+    lines += ["", "| ε | spectral radius |", "|---|---|"]
+    lines += [f"| {r['epsilon']:.1e} | {_fmt(r['spectral_radius'])} |" for r in record["epsilon_sweep"]]
+    verdict = fq.record_verdict(record)
+    verdict = f"{verdict} period-1 orbit" if verdict in ("stable", "unstable") else verdict
+    lines += ["", f"**Spectral radius {record['spectral_radius']:.4f}** ({verdict}). Multipliers, largest first:",
+              "", "| multiplier | modulus | mode (largest components) |", "|---|---|---|"]
+    modes = {tuple(m["multiplier"]): m for m in record["dominant_modes"]}
+    for k, (re, im) in enumerate(record["multipliers"][:6]):
+        mode = modes.get((re, im))
+        what = ", ".join(f"{c['name']} {c['magnitude']:.2f}" for c in mode["components"][:3]) if mode else (
+            record["trivial"][k] or "")
+        lines.append(f"| {re:.4f}{im:+.4f}i | {math.hypot(re, im):.4f} | {what} |")
+    rest = len(record["multipliers"]) - 6
+    if rest > 0:
+        lines.append(f"| … {rest} more below {math.hypot(*record['multipliers'][6]):.1e} | | |")
+    period = record.get("orbit_period")
+    if period:
+        transient, tol = record["settings"]["period_transient"], record["settings"]["period_tolerance"]
+        if period.get("period"):
+            k = period["period"]
+            lead = period["multipliers"][0] if period.get("multipliers") else None
+            lines += ["", f"**The map's attractor: period-{k}** (its iterates after {transient} steps repeat every {k} "
+                      f"to {tol:g}); the {k}-fold map's leading multiplier "
+                      + (f"{lead[0]:.4f}{lead[1]:+.4f}i (|{math.hypot(*lead):.4f}|)" if lead else "—")
+                      + f", orbit residual {period['residual']:.1e}."]
+        elif period.get("spread") is not None:
+            lines += ["", f"**The map's iterates repeat with no period up to 8** (to {tol:g}, after {transient} "
+                      f"steps; their coordinates still range over up to {period['spread']:.2g}): the period-1 "
+                      "figures above are of the orbit Newton finds nearest, not one the iterates settle on."]
+    d = record["decay"]
+    lines += ["", "Perturbation of size {:.0e} along the dominant mode, |deviation| per step:".format(d["size"]), "",
+              "| step | " + " | ".join(str(k + 1) for k in range(len(d["predicted"]))) + " |",
+              "|---|" + "---|" * len(d["predicted"]),
+              "| predicted J^k δ | " + " | ".join(f"{v:.2e}" for v in d["predicted"]) + " |",
+              "| map iterated | " + " | ".join(f"{v:.2e}" for v in d["map_iterated"]) + " |"]
+    if d.get("continued"):
+        lines.append("| walk continued | " + " | ".join(f"{v:.2e}" for v in d["continued"]) + " |")
+    if record.get("sampling_phase_drift"):
+        period_ms = 1e3 * clock_of_record(record["config"]["sim"])[1]
+        lines += ["", "The fixed point walked on without restarting the update grid drifts from itself by "
+                  + ", ".join(f"{v:.1e}" for v in record["sampling_phase_drift"])
+                  + f" per step: the gait's sensitivity to the phase of the {period_ms:g} ms control update, "
+                  "which the map (restarted at each section) does not see."]
+    lines.append("")
+    return "\n".join(lines)
+
+
+def figure(record: dict[str, Any], path: Path) -> None:
+    """floquet.png: the multipliers in the unit circle, and the sweep's spectral radius against ε."""
+    from drake_biped.analysis.figures import floquet_figure
+
+    floquet_figure(record, path)
+
+
+def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
+    """Compute on `client` (a LocalCluster when None); write floquet.json, floquet.md, floquet.png into
+    `out`. The record."""
+    check_settings(settings, FloquetSettings, "floquet.run")
+    from drake_biped.common.executor import client_or_local
+
+    out = Path(out)
+    with client_or_local(client) as c:
+        record = analyse(settings, c)
+    record.update(config=settings.config.to_dict(), settings=settings.to_dict(), seed=settings.config.seed,
+                  versions=versions())
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "floquet.json", record)
+    write_text_atomic(out / "floquet.md", markdown(record))
+    figure(record, out / "floquet.png")
+    return record
+
+
+
+
+
+
+
+
