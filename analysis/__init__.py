@@ -1,1 +1,1 @@
-"""Analysis: pure math of arrays (cost_of_transport, reward, return_map, series, landscape) and the figures and reports drawn from saved records (figures, stability_report, reproduce_report)."""
+"""Analysis: the measures, pure math of arrays (cost_of_transport, reward, long_run, series, attractor, return_map, landscape, floquet, learner_comparison, rewalks), and the figures and reports drawn from saved records (figures, stability_report, reproduce_report). Nothing here builds or steps a diagram (the step map through Drake is drake_biped/step_map.py)."""

@@ -2,7 +2,7 @@
 Jacobian by central differences, a sweep of the perturbation that shows where the Jacobian has converged,
 the multipliers (Floquet multipliers of the orbit) and their eigenvectors, and the decay of a perturbation
 the linearisation predicts. Plain numpy and scipy, on any map given as a function; nothing here knows about
-Drake (analysis/step_map.py is the biped's map through the simulator).
+Drake (drake_biped/step_map.py is the biped's map through the simulator).
 
 The maps are evaluated in batches: `evaluate(points) -> outputs` takes a list of states and returns the
 next states (None for a step that failed: a fall), so that a caller can run a Jacobian's 2n steps in
@@ -12,6 +12,9 @@ On a Poincaré section of an autonomous system one multiplier is trivial: a pert
 moves the crossing in time, and the map sends it back onto the section. In section coordinates that keep
 every state variable (the section's constraint g(x) = 0 not eliminated), that multiplier is exactly 0 and
 its left eigenvector is the section's normal ∇g (g(P(x)) = 0 for every x, so ∇g·DP = 0).
+
+The `floquet` command (drake_biped/experiments/floquet.py) shares this module's name by design: it runs these
+computations on the biped's step map; this module is their mathematics.
 """
 
 from __future__ import annotations

@@ -9,6 +9,9 @@ a lot; the learner then converges, correctly, to no window. This module estimate
 The reward of a sampled t follows the learning run exactly (`drake_biped.analysis.reward`, times below 0
 act as 0, t2 <= t1 means no window); a window between grid points takes the reward of the nearest measured
 window (the map's spacing bounds the resolution). Plain numpy and scipy.
+
+The `landscape` command (drake_biped/experiments/landscape.py) shares this module's name by design: it reads a
+window map and writes what this module computes.
 """
 
 from __future__ import annotations

@@ -10,6 +10,9 @@ learning run (a learning.json record) and that window:
 - episodes to within 5 %: the first episode at which the trial's running C_mt (the mean over the last
   RUNNING episodes that walked) is within 5 % of the best window's; None where it never is;
 - falls: episodes that fell, summed over trials.
+
+Named for the `compare-learners` command (drake_biped/experiments/compare_learners.py) by design: that runs the
+learners, this reduces their records.
 """
 
 from __future__ import annotations

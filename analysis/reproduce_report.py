@@ -4,6 +4,9 @@ Built from the experiments' summaries (DIR/<name>/summary.json) and the Markdown
 itself (Table V, the stability report, the slope reports, the time-step study), which are embedded with
 their headings demoted and their figure links made relative to DIR. The HTML is the same Markdown rendered
 by Python-Markdown (tables extension), figures linked from the experiments' folders.
+
+Named for the `reproduce` command (drake_biped/experiments/reproduce.py) by design: that runs the experiments,
+this writes their report.
 """
 
 from __future__ import annotations

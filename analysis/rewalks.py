@@ -7,6 +7,9 @@ A walk's saving is 1 - C_mt(window) / C_mt(no window) under the same change, eac
 averaged). A trial's saving is the mean of its four walks' (as learned and the
 three changes); the run's figure is the mean over trials with its standard deviation. A trial holds when every
 one of its four walks walks and saves at least HOLD_SAVING.
+
+The `rewalk` command (drake_biped/experiments/rewalk.py) walks the windows again; this module, named for its
+records by design, reduces them.
 """
 
 from __future__ import annotations

@@ -1,4 +1,8 @@
-"""Fig. 7 and the stability report (Table VI beside the paper's), drawn from a stability record alone."""
+"""Fig. 7 and the stability report (Table VI beside the paper's), drawn from a stability record alone.
+
+Named for the `stability` command (drake_biped/experiments/stability.py) by design: that runs the walks, this
+draws their record.
+"""
 
 from __future__ import annotations
 

@@ -24,13 +24,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-try:  # the installed distribution's version (pyproject.toml): typed in one place
-    from importlib.metadata import PackageNotFoundError as _NotFound
-    from importlib.metadata import version as _version
-
-    __version__ = _version("drake-biped")
-except _NotFound:  # run from a source tree that was never installed
-    __version__ = "0+unknown"
+from drake_biped.versions import PACKAGE_VERSION as __version__
 
 # name -> module that defines it
 _API = {

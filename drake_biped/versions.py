@@ -7,15 +7,18 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["versions"]
+__all__ = ["PACKAGE_VERSION", "versions"]
+
+try:  # the installed distribution's version (pyproject.toml): typed in one place
+    PACKAGE_VERSION = metadata.version("drake-biped")
+except metadata.PackageNotFoundError:  # run from a source tree that was never installed
+    PACKAGE_VERSION = "0+unknown"
 
 
 @functools.lru_cache(maxsize=1)
 def versions() -> dict[str, str | None]:
     """Package version, git commit of a source checkout (with '+dirty' when the tree has changes; None when
     installed from a wheel) and Drake version."""
-    from drake_biped import __version__
-
     root = Path(__file__).resolve().parent.parent
     commit = None
     if not (root / ".git").exists():  # an installed package: its version is the code version
@@ -38,4 +41,4 @@ def versions() -> dict[str, str | None]:
         drake = metadata.version("drake")
     except metadata.PackageNotFoundError:
         drake = None
-    return {"drake_biped": __version__, "git_commit": commit, "drake": drake}
+    return {"drake_biped": PACKAGE_VERSION, "git_commit": commit, "drake": drake}

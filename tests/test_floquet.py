@@ -199,8 +199,8 @@ def test_the_rimless_wheel_multiplier_is_cos_squared_two_alpha():
 # --- the biped's step map through Drake ----------------------------------------------------------------
 @pytest.fixture(scope="module")
 def biped_map():
-    from drake_biped.analysis.step_map import SectionMap
     from drake_biped.params import EpisodeConfig
+    from drake_biped.step_map import SectionMap
 
     section_map = SectionMap(EpisodeConfig())
     z0, template = section_map.start(6)
@@ -224,7 +224,7 @@ def test_a_restart_from_an_update_continues_the_walk_exactly(biped_map):
     snapshot taken at an update, with its clocks moved to time 0, the walk to the next section is the
     walk that continued, to the bit."""
     from drake_biped import controller as ctl
-    from drake_biped.analysis.step_map import Snapshot
+    from drake_biped.step_map import Snapshot
 
     section_map, z0, template = biped_map
     section_map.step(z0)  # leaves the simulator just past the next section
@@ -245,7 +245,7 @@ def test_a_restart_from_an_update_continues_the_walk_exactly(biped_map):
 @pytest.mark.slow
 def test_the_held_slots_do_not_change_the_map(biped_map):
     from drake_biped import controller as ctl
-    from drake_biped.analysis.step_map import Snapshot
+    from drake_biped.step_map import Snapshot
 
     section_map, z0, template = biped_map
     base = section_map.step(z0, template)

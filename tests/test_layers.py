@@ -34,7 +34,7 @@ LAYERS = {
     "drake_biped.diagram": CORE,
     "drake_biped.episode": CORE,
     "drake_biped.analysis.figures": RECORDS,
-    "drake_biped.analysis.step_map": RECORDS,
+    "drake_biped.step_map": CORE,
     "drake_biped.analysis.stability_report": RECORDS,
     "drake_biped.analysis.reproduce_report": RECORDS,
     "drake_biped.experiments.rewalk": EXPERIMENTS,

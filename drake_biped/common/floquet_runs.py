@@ -1,6 +1,6 @@
 """The gait's periodic orbit and its Floquet multipliers through Drake (`drake-biped floquet`).
 
-The full-state step map on the mid-stance section (analysis/step_map.py) is evaluated on Dask: the fixed
+The full-state step map on the mid-stance section (drake_biped/step_map.py) is evaluated on Dask: the fixed
 point by Newton's method from the steady walk, the central-difference Jacobian for a sweep of the
 perturbation over several decades, the multipliers at the converged ε with their eigenvectors by name, and
 two cross-checks: the linearisation's prediction of a small perturbation's next steps against the map
@@ -91,8 +91,8 @@ class FloquetSettings:
 
 def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
     """A batch evaluator of the step map on `client`: the points split evenly over its workers."""
-    from drake_biped.analysis.step_map import evaluate_task
     from drake_biped.common.executor import DrakeGuarded
+    from drake_biped.step_map import evaluate_task
 
     workers = max(1, len(client.scheduler_info()["workers"]))
 
@@ -127,7 +127,7 @@ def orbit_radius(config: EpisodeConfig, settle_steps: int = 8, epsilon: float = 
     Newton from the section after `settle_steps` touchdowns, then one central-difference Jacobian at
     `epsilon` at the fixed point. Raises ParameterError when the gait falls before its section, StepFailed
     when a perturbed step falls."""
-    from drake_biped.analysis.step_map import SectionMap
+    from drake_biped.step_map import SectionMap
 
     section_map = SectionMap(config)
     z0, template = section_map.start(settle_steps)
@@ -167,7 +167,7 @@ def orbit_period(settings: FloquetSettings, evaluate: fq.Batch, z0: np.ndarray, 
 
 def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     """The fixed point, the sweep, the multipliers and the cross-checks of `settings.config`'s gait."""
-    from drake_biped.analysis.step_map import SectionMap
+    from drake_biped.step_map import SectionMap
 
     wall0 = time.perf_counter()
     section_map = SectionMap(settings.config)  # raises ParameterError for a ground or push it cannot take
