@@ -13,7 +13,8 @@ from typing import Any
 from drake_biped.params import ParameterError
 
 __all__ = ["LOCK_FILE", "RUN_FILE", "atomic_file", "claim_folder", "read_json", "read_kept", "read_kept_lines",
-           "save_figure", "set_aside", "stored", "warn", "write_atomic", "write_text_atomic"]
+           "save_figure", "set_aside", "stored", "warn", "write_atomic", "write_record",
+           "write_text_atomic"]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -30,6 +31,20 @@ def write_text_atomic(path: Path, text: str) -> None:
 def write_atomic(path: Path, data: Any) -> None:
     """`data` as JSON (NaN refused), written atomically."""
     write_text_atomic(path, json.dumps(data, indent=1, allow_nan=False) + "\n")
+
+
+def write_record(out: Path | str, name: str, record: dict[str, Any],
+                 markdown: Callable[[dict[str, Any]], str] | None = None,
+                 figure: Callable[[dict[str, Any], Path], Any] | None = None) -> None:
+    """An experiment's outputs: out/NAME.json holds the record; out/NAME.md (its report) and out/NAME.png (its
+    figure) are drawn from the record alone, where `markdown` and `figure` are given."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / f"{name}.json", record)
+    if markdown is not None:
+        write_text_atomic(out / f"{name}.md", markdown(record))
+    if figure is not None:
+        figure(record, out / f"{name}.png")
 
 
 def stored(path: Path) -> Path:

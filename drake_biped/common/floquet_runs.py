@@ -25,7 +25,7 @@ from drake_biped.common.options import (
     check_size,
 )
 from drake_biped.params import EpisodeConfig, ParameterError, check_settings, clock_of_record
-from drake_biped.records import write_atomic, write_text_atomic
+from drake_biped.records import write_record
 from drake_biped.versions import versions
 
 __all__ = ["FloquetSettings", "analyse", "markdown", "run"]
@@ -349,10 +349,7 @@ def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
         record = analyse(settings, c)
     record.update(config=settings.config.to_dict(), settings=settings.to_dict(), seed=settings.config.seed,
                   versions=versions())
-    out.mkdir(parents=True, exist_ok=True)
-    write_atomic(out / "floquet.json", record)
-    write_text_atomic(out / "floquet.md", markdown(record))
-    figure(record, out / "floquet.png")
+    write_record(out, "floquet", record, markdown, figure)
     return record
 
 

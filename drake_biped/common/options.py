@@ -242,6 +242,14 @@ def cluster(args: argparse.Namespace):
         yield client
 
 
+def run_command(args: argparse.Namespace, settings_from_args, run) -> dict:
+    """A command's run: its settings read from `args` (bad input refused before any cluster starts), then
+    `run(settings, out, client)` on the cluster the options name, writing under --out; the record."""
+    settings = settings_from_args(args)
+    with cluster(args) as client:
+        return run(settings, Path(args.out), client)
+
+
 def print_lines(lines) -> None:
     print("\n".join(lines))
 

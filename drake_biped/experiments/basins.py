@@ -35,7 +35,7 @@ from drake_biped.common.walks import (
     condition_window,
 )
 from drake_biped.params import LEARNED_WINDOW_S, EpisodeConfig, ParameterError, check_settings
-from drake_biped.records import save_figure, write_atomic, write_text_atomic
+from drake_biped.records import save_figure, write_record
 from drake_biped.versions import versions
 
 __all__ = ["BasinSettings", "basins", "markdown", "reading", "run"]
@@ -186,13 +186,10 @@ def run(settings: BasinSettings, out: Path, client=None, progress: bool = True) 
     with progress_bar(settings.walks, "basins", "walk", progress) as tick, client_or_local(client) as c:
         record = basins(settings, out, c, tick)
     record.update(config=settings.config.to_dict(), versions=versions())
-    write_atomic(out / "basins.json", record)
-    write_text_atomic(out / "basins.md", markdown(record))
-    figure(record, out / "basins.png")
+    write_record(out, "basins", record, markdown, figure)
     return record
 
 
-# The command line: `drake-biped basins` (drake_biped/cli.py runs `command`).
 COMMAND = "basins"
 PARSER = dict(help="a slice of starts (initial hip angle x speed) coloured by what each walk ends on, with and "
               "without a torque-free period (on Dask, resumable)")
@@ -233,11 +230,9 @@ def settings_from_args(args: argparse.Namespace) -> BasinSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    from drake_biped.common.options import cluster
+    from drake_biped.common.options import run_command
 
-    settings = settings_from_args(args)
-    with cluster(args) as client:
-        record = run(settings, Path(args.out), client)
+    record = run_command(args, settings_from_args, run)
     print(markdown(record))
     print(f"wrote {args.out}/basins.json, basins.md, basins.png")
     return 0

@@ -53,7 +53,7 @@ from drake_biped.params import (
     check_settings,
     resolve_field,
 )
-from drake_biped.records import save_figure, write_atomic, write_text_atomic
+from drake_biped.records import save_figure, write_record
 from drake_biped.versions import versions
 
 __all__ = ["BifurcationSettings", "markdown", "premise", "run", "walked_up_to"]
@@ -310,13 +310,10 @@ def run(settings: BifurcationSettings, out: Path, client=None, progress: bool = 
     with progress_bar(walks_count, "bifurcation", "walk", progress) as tick, client_or_local(client) as c:
         record = bifurcation(settings, out, c, tick)
     record.update(config=settings.config.to_dict(), versions=versions())
-    write_atomic(out / "bifurcation.json", record)
-    write_text_atomic(out / "bifurcation.md", markdown(record))
-    figure(record, out / "bifurcation.png")
+    write_record(out, "bifurcation", record, markdown, figure)
     return record
 
 
-# The command line: `drake-biped bifurcation` (drake_biped/cli.py runs `command`).
 COMMAND = "bifurcation"
 PARSER = dict(help="long walks over a range of one parameter: the attractor each settles on (period-k, irregular, "
               "fall), read at 2 ms and at the controller's jitter, irregular ones with a Lyapunov exponent (on Dask, "
@@ -368,12 +365,9 @@ def settings_from_args(args: argparse.Namespace) -> BifurcationSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = settings_from_args(args)
-    out = Path(args.out)
-    from drake_biped.common.options import cluster
+    from drake_biped.common.options import run_command
 
-    with cluster(args) as client:
-        record = run(settings, out, client)
+    record = run_command(args, settings_from_args, run)
     print(markdown(record))
-    print(f"wrote {out}/bifurcation.json, bifurcation.md, bifurcation.png")
+    print(f"wrote {args.out}/bifurcation.json, bifurcation.md, bifurcation.png")
     return 0

@@ -32,7 +32,7 @@ from drake_biped.common.options import (
 )
 from drake_biped.paper import GARB_MEAN_S, GARB_VARIANCE_S2
 from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
-from drake_biped.records import read_json, write_atomic, write_text_atomic
+from drake_biped.records import read_json, write_record
 from drake_biped.versions import versions
 
 __all__ = ["CompareSettings", "run", "summary_lines"]
@@ -134,9 +134,7 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
         "learners": rows,
         "versions": versions(),
     }
-    write_atomic(out / "compare.json", record)
-    write_text_atomic(out / "compare.md", markdown(record))
-    learner_comparison_figure(curves, record, out / "compare.png")
+    write_record(out, "compare", record, markdown, lambda rec, path: learner_comparison_figure(curves, rec, path))
     return record
 
 
@@ -183,7 +181,6 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     return [markdown(record), f"wrote {out}/compare.json, compare.md, compare.png and one learning run per learner"]
 
 
-# The command line: `drake-biped compare-learners` (drake_biped/cli.py runs `command`).
 COMMAND = "compare-learners"
 PARSER = dict(help="learners side by side against the window map's best window")
 

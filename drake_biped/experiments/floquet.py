@@ -6,22 +6,20 @@ search share."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from drake_biped.common.floquet_runs import FloquetSettings, run
 from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
     chosen_window,
-    cluster,
     count,
     episode_config,
     number,
     out_folder,
     positive_list,
+    run_command,
 )
 
-# The command line: `drake-biped floquet` (drake_biped/cli.py runs `command`).
 COMMAND = "floquet"
 
 
@@ -56,10 +54,7 @@ def settings_from_args(args: argparse.Namespace) -> FloquetSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = settings_from_args(args)
-    out = Path(args.out)
-    with cluster(args) as client:
-        record = run(settings, out, client)
+    record = run_command(args, settings_from_args, run)
     from drake_biped.analysis.floquet import record_verdict
 
     epsilon = record["converged_epsilon"]
@@ -67,5 +62,5 @@ def command(args: argparse.Namespace) -> int:
           f"{record['fixed_point_residual']:.1e}, "
           + ("no perturbation converged" if epsilon is None else f"converged at epsilon {epsilon:g}")
           + f": {record_verdict(record)}")
-    print(f"wrote {out}/floquet.json, floquet.md, floquet.png")
+    print(f"wrote {args.out}/floquet.json, floquet.md, floquet.png")
     return 0

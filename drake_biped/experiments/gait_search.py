@@ -55,6 +55,16 @@ from drake_biped.params import (
 from drake_biped.records import read_kept_lines, write_text_atomic
 from drake_biped.versions import versions
 
+# The swing knee's switches and torques, searched alike by every mutation set that moves them.
+KNEE_MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
+    ("gait", "knee_flex_torque"): ("log", 0.1, 0.1, 30.0),
+    ("gait", "knee_extend_torque"): ("log", 0.1, 0.1, 30.0),
+    ("gait", "knee_flex_max_rad"): ("log", 0.1, 0.05, 2.4),
+    ("gait", "knee_flex_until_phase"): ("add", 0.1, 0.0, math.pi),
+    ("gait", "knee_extend_phase"): ("add", 0.1, 0.5, 3.1),
+    ("gait", "knee_extend_thigh_rad"): ("add", 0.04, -0.9, 0.9),
+}
+
 ACCEPTANCE_WINDOWS = ((0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.35, 0.65), (0.2, 0.7))
 # (section, field): (kind, step at sigma = 0.1, lower bound, upper bound)
 MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
@@ -65,12 +75,7 @@ MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
     ("gait", "hip_kd"): ("log", 0.1, 0.1, 200.0),
     ("gait", "placement_gain"): ("log", 0.1, 0.0, 4.9),
     ("gait", "placement_velocity_gain"): ("log", 0.1, 0.0, 4.9),
-    ("gait", "knee_flex_torque"): ("log", 0.1, 0.1, 30.0),
-    ("gait", "knee_extend_torque"): ("log", 0.1, 0.1, 30.0),
-    ("gait", "knee_flex_max_rad"): ("log", 0.1, 0.05, 2.4),
-    ("gait", "knee_flex_until_phase"): ("add", 0.1, 0.0, math.pi),
-    ("gait", "knee_extend_phase"): ("add", 0.1, 0.5, 3.1),
-    ("gait", "knee_extend_thigh_rad"): ("add", 0.04, -0.9, 0.9),
+    **KNEE_MUTATIONS,
     ("gait", "torso_pitch_rad"): ("add", 0.015, -0.45, 0.0),
     ("gait", "touchdown_min_phase"): ("add", 0.1, 0.3, 3.1),
 }
@@ -86,12 +91,7 @@ PAPER_MUTATIONS: dict[tuple[str, str], tuple[str, float, float, float]] = {
     ("gait", "torso_kp"): ("log", 0.1, 20.0, 5000.0),
     ("gait", "torso_kd"): ("log", 0.1, 2.0, 500.0),
     ("gait", "torso_pitch_rad"): ("add", 0.015, -0.45, 0.1),
-    ("gait", "knee_flex_torque"): ("log", 0.1, 0.1, 30.0),
-    ("gait", "knee_extend_torque"): ("log", 0.1, 0.1, 30.0),
-    ("gait", "knee_flex_max_rad"): ("log", 0.1, 0.05, 2.4),
-    ("gait", "knee_flex_until_phase"): ("add", 0.1, 0.0, math.pi),
-    ("gait", "knee_extend_phase"): ("add", 0.1, 0.5, 3.1),
-    ("gait", "knee_extend_thigh_rad"): ("add", 0.04, -0.9, 0.9),
+    **KNEE_MUTATIONS,
     ("gait", "stance_knee_torque"): ("log", 0.1, 1.0, 30.0),
     ("gait", "ankle_kp"): ("log", 0.1, 1.0, 400.0),
     ("gait", "ankle_kd"): ("log", 0.1, 0.05, 40.0),
@@ -638,56 +638,14 @@ def _nearest_score(config, base, windows, draws):
                                             "distance_from_table_iii": d}
 
 
-def _floquet_score(config, base, windows, draws):
-    return _orbit_score(config, base)
+def _of_base(score_fn, *extra):
+    """An objective that reads the gait and its walk without a window alone."""
+    return lambda config, base, windows, draws: score_fn(config, base, *extra)
 
 
-def _landscape_objective(config, base, windows, draws):
-    return _landscape_score(config, base)
-
-
-def _robust_objective(config, base, windows, draws):
-    return _robust_score(config, base)
-
-
-def _story_objective(config, base, windows, draws):
-    return _story_score(config, base, draws)
-
-
-def _hold_objective(config, base, windows, draws):
-    return _hold_score(config, base)
-
-
-def _hold_long_objective(config, base, windows, draws):
-    return _hold_long_score(config, base)
-
-
-def _hold_step_objective(config, base, windows, draws):
-    return _hold_step_score(config, base)
-
-
-def _hold_slow_objective(config, base, windows, draws):
-    return _hold_slow_score(config, base)
-
-
-def _hold_edge_objective(config, base, windows, draws):
-    return _hold_edge_score(config, base)
-
-
-def _hold_lure_objective(config, base, windows, draws):
-    return _hold_lure_score(config, base)
-
-
-def _hold_sure_objective(config, base, windows, draws):
-    return _hold_sure_score(config, base)
-
-
-def _hold_fine_objective(config, base, windows, draws):
-    return _hold_sure_score(config, base, _step_ladder)
-
-
-def _hold_pull_objective(config, base, windows, draws):
-    return _hold_pull_score(config, base, draws)
+def _of_draws(score_fn):
+    """An objective that reads the gait, its walk without a window and the start policy's draws."""
+    return lambda config, base, windows, draws: score_fn(config, base, draws)
 
 
 # Every objective a search can score by: its function and what it scores (the module docstring, the command's
@@ -699,19 +657,19 @@ OBJECTIVES: dict[str, Objective] = {
     "expected": Objective(_expected_score, False, "The expected reward's gain alone, over the same draws (one drawn window that saves much cannot carry a gait whose other draws fall)."),
     "nearest": Objective(_nearest_score, False, '-(d / (1 + d) + f) / 3, d the CPG\'s distance from Table III (`distance_from_table_iii`) and f how many of the +-PUSH_FORCE_N pushes (stability\'s, without a window) the gait does not walk through, to find the walker whose CPG is nearest the paper\'s (with the "near_paper" mutations); in (-1, 0], so any walker, however far, beats every fall, and one that survives both pushes beats every one that does not (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push).'),
     "coast": Objective(_coast_score, False, 'The same score over COAST_WINDOWS, the hip off from t1 = 0.2 ... 0.5 s until the swing foot lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau).'),
-    "floquet": Objective(_floquet_score, False, "(1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit (`common.floquet_runs.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map): positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3; FLOQUET_UNDEFINED (-1) when a perturbed step falls."),
-    "landscape": Objective(_landscape_objective, False, "The same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s) through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through."),
-    "robust": Objective(_robust_objective, True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold."),
-    "story": Objective(_story_objective, True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
-    "hold": Objective(_hold_objective, True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
-    "hold-long": Objective(_hold_long_objective, True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
-    "hold-step": Objective(_hold_step_objective, True, 'The "robust" objective first, then windows placed by the gait\'s own powered step period T (its long walk without a window): t1 = T - HOLD_STEP_BELOW_S (the hip off until the foot lands) judged as in "hold-long", minus the largest saving of a 10 m episode from the initiation with t1 = T + HOLD_STEP_PAST_S (a window that saves there only while the initiation\'s long first steps last draws GARB past the step\'s end): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
-    "hold-slow": Objective(_hold_slow_objective, True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
-    "hold-edge": Objective(_hold_edge_objective, True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
-    "hold-lure": Objective(_hold_lure_objective, True, 'The "robust" objective first, then HOLD_LURE_WINDOWS (t1 0.40 to 0.46 s, the hip off until the foot lands) judged as in "hold-long", plus HOLD_LURE_WEIGHT x the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s: what brings GARB\'s means back from the no-window half of its start): least saving + 0.5 x that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
-    "hold-sure": Objective(_hold_sure_objective, True, 'The "hold-lure" score less SURE_FALL_PENALTY x the fraction of SURE_EARLY_WINDOWS (early windows, where GARB\'s first large steps can carry a mean) that fall over the 10 m episode, and less SURE_PUSH_PENALTY x the fraction of the +-PUSH_FORCE_N pushes in steady state (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a SURE_PUSH_M walk, as `push-margin` pushes; without a window and with SURE_PUSH_WINDOW) that fall, and less SURE_STEP_PENALTY x how far the long-run C_mt of the walk without a window at a quarter of the plant step moves beyond SURE_STEP_TOLERANCE from the step\'s (1 when it falls).'),
-    "hold-fine": Objective(_hold_fine_objective, True, 'The "hold-sure" score with its step check made the time-step study\'s: SURE_STEP_PENALTY x how far the largest change of the long-run C_mt without a window, walked FINE_STEP_M at each of FINE_STEP_FRACTIONS of the plant step (the controller refined with it under the paper\'s clock), from the finest moves beyond SURE_STEP_TOLERANCE (1 when one falls).'),
-    "hold-pull": Objective(_hold_pull_objective, True, 'The "hold-edge" score plus the mean reward gain over --policy-draws fixed draws of the paper\'s start policy ((0.5, 0.5), variance 0.04; the "expected" objective): where the learner\'s first episodes fall or save.'),
+    "floquet": Objective(_of_base(_orbit_score), False, "(1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit (`common.floquet_runs.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map): positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3; FLOQUET_UNDEFINED (-1) when a perturbed step falls."),
+    "landscape": Objective(_of_base(_landscape_score), False, "The same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s) through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through."),
+    "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold."),
+    "story": Objective(_of_draws(_story_score), True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
+    "hold": Objective(_of_base(_hold_score), True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
+    "hold-long": Objective(_of_base(_hold_long_score), True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
+    "hold-step": Objective(_of_base(_hold_step_score), True, 'The "robust" objective first, then windows placed by the gait\'s own powered step period T (its long walk without a window): t1 = T - HOLD_STEP_BELOW_S (the hip off until the foot lands) judged as in "hold-long", minus the largest saving of a 10 m episode from the initiation with t1 = T + HOLD_STEP_PAST_S (a window that saves there only while the initiation\'s long first steps last draws GARB past the step\'s end): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
+    "hold-slow": Objective(_of_base(_hold_slow_score), True, 'The "hold-step" score minus HOLD_SLOW_PENALTY x how far the powered step T falls short of HOLD_SLOW_FLOOR_S (GARB starts at t1 = 0.5 s: on a shorter step the windows near its start never act in the steady gait).'),
+    "hold-edge": Objective(_of_base(_hold_edge_score), True, 'The "robust" objective first, then HOLD_EDGE_WINDOWS (t1 0.40, 0.42, 0.44 s, where GARB\'s means ended, the hip off until the foot lands) judged as in "hold-long", minus the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s, the learner\'s start region): least saving - that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
+    "hold-lure": Objective(_of_base(_hold_lure_score), True, 'The "robust" objective first, then HOLD_LURE_WINDOWS (t1 0.40 to 0.46 s, the hip off until the foot lands) judged as in "hold-long", plus HOLD_LURE_WEIGHT x the larger 10 m saving from the initiation at HOLD_EDGE_LURE (t1 0.48 and 0.50 s: what brings GARB\'s means back from the no-window half of its start): least saving + 0.5 x that lure + 0.1 x the mean saving - 0.01 d / (1 + d).'),
+    "hold-sure": Objective(_of_base(_hold_sure_score), True, 'The "hold-lure" score less SURE_FALL_PENALTY x the fraction of SURE_EARLY_WINDOWS (early windows, where GARB\'s first large steps can carry a mean) that fall over the 10 m episode, and less SURE_PUSH_PENALTY x the fraction of the +-PUSH_FORCE_N pushes in steady state (SURE_PUSH_PHASES phases of the first step after SURE_SETTLE_S of a SURE_PUSH_M walk, as `push-margin` pushes; without a window and with SURE_PUSH_WINDOW) that fall, and less SURE_STEP_PENALTY x how far the long-run C_mt of the walk without a window at a quarter of the plant step moves beyond SURE_STEP_TOLERANCE from the step\'s (1 when it falls).'),
+    "hold-fine": Objective(_of_base(_hold_sure_score, _step_ladder), True, 'The "hold-sure" score with its step check made the time-step study\'s: SURE_STEP_PENALTY x how far the largest change of the long-run C_mt without a window, walked FINE_STEP_M at each of FINE_STEP_FRACTIONS of the plant step (the controller refined with it under the paper\'s clock), from the finest moves beyond SURE_STEP_TOLERANCE (1 when one falls).'),
+    "hold-pull": Objective(_of_draws(_hold_pull_score), True, 'The "hold-edge" score plus the mean reward gain over --policy-draws fixed draws of the paper\'s start policy ((0.5, 0.5), variance 0.04; the "expected" objective): where the learner\'s first episodes fall or save.'),
 }
 
 
@@ -958,7 +916,6 @@ def _append(path: Path, record: dict) -> None:
         f.flush()
 
 
-# The command line: `drake-biped gait-search` (drake_biped/cli.py runs `command`).
 COMMAND = "gait-search"
 PARSER = dict(help="evolve gait parameters for walking and torque-free savings",
               epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))

@@ -365,7 +365,6 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
             f"wrote {out}/grid.csv, grid.json, grid_slices.png, best_params.json (use --params)"]
 
 
-# The command line: `drake-biped grid` (drake_biped/cli.py runs `command`).
 COMMAND = "grid"
 PARSER = dict(help="grid search of CPG parameters and the initiation (Table IV), on Dask")
 

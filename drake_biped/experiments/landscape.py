@@ -98,7 +98,6 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     return lines
 
 
-# The command line: `drake-biped landscape` (drake_biped/cli.py runs `command`).
 COMMAND = "landscape"
 PARSER = dict(help="the expected reward GARB climbs, from a window map, for given variances")
 

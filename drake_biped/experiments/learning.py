@@ -58,7 +58,6 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
     return lines
 
 
-# The command line: `drake-biped learn` (drake_biped/cli.py runs `command`).
 COMMAND = "learn"
 
 

@@ -25,11 +25,11 @@ from drake_biped.common.options import (
     add_episode_options,
     add_window_options,
     chosen_window,
-    cluster,
     count,
     episode_config,
     number,
     out_folder,
+    run_command,
 )
 from drake_biped.common.walks import CONDITIONS, condition_window, steady_step
 from drake_biped.paper import PUSH_DURATION_S
@@ -41,7 +41,7 @@ from drake_biped.params import (
     check_settings,
     walked_the_distance,
 )
-from drake_biped.records import save_figure, write_atomic, write_text_atomic
+from drake_biped.records import save_figure, write_record
 from drake_biped.versions import versions
 
 __all__ = ["PushMarginSettings", "margin_of", "margin_text", "markdown", "push_margin", "run"]
@@ -245,14 +245,10 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
             client_or_local(client) as c:
         record = push_margin(settings, c, progress=tick)
     record.update(config=settings.config.to_dict(), versions=code)
-    out.mkdir(parents=True, exist_ok=True)
-    write_atomic(out / "push_margin.json", record)
-    write_text_atomic(out / "push_margin.md", markdown(record))
-    figure(record, out / "push_margin.png")
+    write_record(out, "push_margin", record, markdown, figure)
     return record
 
 
-# The command line: `drake-biped push-margin` (drake_biped/cli.py runs `command`).
 COMMAND = "push-margin"
 PARSER = dict(help="pushes in steady state over a grid of forces and phases of the step, "
               "with and without a torque-free period: the survival map and the margins (on Dask)")
@@ -283,10 +279,8 @@ def settings_from_args(args: argparse.Namespace) -> PushMarginSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = settings_from_args(args)
+    run_command(args, settings_from_args, run)
     out = Path(args.out)
-    with cluster(args) as client:
-        run(settings, out, client)
     print((out / "push_margin.md").read_text())
     print(f"wrote {out}/push_margin.json, push_margin.md, push_margin.png")
     return 0

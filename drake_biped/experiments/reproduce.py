@@ -636,7 +636,6 @@ def check_out(out: Path, profile: Profile) -> None:
     write_atomic(marker, profile.to_dict())
 
 
-# The command line: `drake-biped reproduce` (drake_biped/cli.py runs `command`).
 COMMAND = "reproduce"
 PARSER = dict(help="every experiment of the paper and one report beside its numbers "
               "(--quick: small settings, minutes)")

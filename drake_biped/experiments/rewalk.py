@@ -17,8 +17,8 @@ from typing import Any
 from drake_biped.common.learning_record import check_learning_record
 from drake_biped.common.options import (
     add_cluster_options,
-    cluster,
     out_folder,
+    run_command,
 )
 from drake_biped.common.walks import rewalk
 from drake_biped.params import (
@@ -26,7 +26,7 @@ from drake_biped.params import (
     check_settings,
     config_of_record,
 )
-from drake_biped.records import read_json
+from drake_biped.records import read_json, write_record
 from drake_biped.versions import versions
 
 __all__ = ["RewalkSettings", "rewalk_record", "run"]
@@ -67,19 +67,15 @@ def run(settings: RewalkSettings, out: Path, client=None, progress: bool = True)
     rewalk.json and rewalk.md into `out`. The record."""
     from drake_biped.analysis.rewalks import markdown
     from drake_biped.common.executor import client_or_local
-    from drake_biped.records import write_atomic, write_text_atomic
 
     check_settings(settings, RewalkSettings, "rewalk.run")
     with client_or_local(client) as c:
         record = rewalk_record(Path(settings.policy), c)
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    write_atomic(out / "rewalk.json", record)
-    write_text_atomic(out / "rewalk.md", markdown(record))
+    write_record(out, "rewalk", record, markdown)
     return record
 
 
-# The command line: `drake-biped rewalk` (drake_biped/cli.py runs `command`).
 COMMAND = "rewalk"
 PARSER = dict(help="a learning run's final policy means re-walked with the plant step halved "
               "and from 0.95 and 1.05 x the initiation speed, each against no window under the same "
@@ -106,10 +102,7 @@ def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
     from drake_biped.analysis.rewalks import markdown
 
-    settings = settings_from_args(args)
-    out = Path(args.out)
-    with cluster(args) as client:
-        record = run(settings, out, client)
+    record = run_command(args, settings_from_args, run)
     print(markdown(record))
-    print(f"wrote {out}/rewalk.json, rewalk.md")
+    print(f"wrote {args.out}/rewalk.json, rewalk.md")
     return 0

@@ -342,7 +342,6 @@ def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
     return record
 
 
-# The command line: `drake-biped slope` (drake_biped/cli.py runs `command`).
 COMMAND = "slope"
 PARSER = dict(help="slope adaptation: does the learned torque-free period climb, does none, "
               "and does online GARB learning adapt it (Figs. 8-11), on Dask")

@@ -34,10 +34,10 @@ from drake_biped.common.options import (
     check_size,
     check_walks,
     chosen_window,
-    cluster,
     count,
     episode_config,
     number,
+    run_command,
 )
 from drake_biped.common.walks import CONDITIONS, condition_window
 from drake_biped.paper import TABLE_VI
@@ -376,7 +376,6 @@ def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, clie
     return found
 
 
-# The command line: `drake-biped stability` (drake_biped/cli.py runs `command`).
 COMMAND = "stability"
 PARSER = dict(help="pushes and Poincare return maps with and without a torque-free "
               "period (Table VI, Fig. 7), on Dask")
@@ -408,10 +407,8 @@ def settings_from_args(args: argparse.Namespace) -> StabilitySettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = settings_from_args(args)
+    run_command(args, settings_from_args, run)
     out = Path(args.out)
-    with cluster(args) as client:
-        run(settings, out, client)
     print("\n".join(line for line in (out / "report.md").read_text().splitlines() if line.startswith("|")))
     print(f"wrote {out}/stability.json, fig7_return_map.png, report.md, report.html")
     return 0

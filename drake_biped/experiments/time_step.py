@@ -397,7 +397,6 @@ def replot(out: Path) -> dict:
     return rec
 
 
-# The command line: `drake-biped time-step-study` (drake_biped/cli.py runs `command`).
 COMMAND = "time-step-study"
 PARSER = dict(help="the long-run C_mt against the plant step (the controller's clock refined with it, or a "
               "fixed-rate loop kept), "

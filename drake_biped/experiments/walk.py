@@ -255,7 +255,6 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
     return result
 
 
-# The command line: `drake-biped walk` (drake_biped/cli.py runs `command`).
 COMMAND = "walk"
 PARSER = dict(help="walk one episode and write its record, figures and animation")
 

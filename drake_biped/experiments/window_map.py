@@ -21,11 +21,11 @@ from drake_biped.analysis.series import signed_percent
 from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
-    cluster,
     episode_config,
     number,
     out_folder,
     print_lines,
+    run_command,
 )
 from drake_biped.params import (
     EpisodeConfig,
@@ -206,7 +206,6 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     return lines
 
 
-# The command line: `drake-biped window-map` (drake_biped/cli.py runs `command`).
 COMMAND = "window-map"
 PARSER = dict(help="C_mt of a grid of torque-free windows against no window")
 
@@ -229,9 +228,7 @@ def settings_from_args(args: argparse.Namespace) -> WindowMapSettings:
 
 def command(args: argparse.Namespace) -> int:
     """Run the command of `args` (its options parsed by add_arguments); the exit code."""
-    settings = settings_from_args(args)
-    with cluster(args) as client:
-        record = run(settings, Path(args.out), client)
+    record = run_command(args, settings_from_args, run)
     print_lines(summary_lines(record))
     print(f"wrote {args.out}/window_map.json, window_map.csv, window_map.png")
     return 0
