@@ -100,11 +100,12 @@ def replay(config: EpisodeConfig, times: np.ndarray, torques: np.ndarray, durati
     simulator = Simulator(diagram)
     root = simulator.get_mutable_context()
     plant_context = plant.GetMyMutableContextFromRoot(root)
-    q0, v0, _, _ = initial_state(config)
+    q0, v0, stance_right, liftoff = initial_state(config)
     plant.SetPositions(plant_context, q0)
     plant.SetVelocities(plant_context, v0)
     if isinstance(observer, CpgWalkingController):
-        observer.set_initial_state(observer.GetMyMutableContextFromRoot(root), q0[3:], center_of_mass(q0)[0])
+        observer.set_initial_state(observer.GetMyMutableContextFromRoot(root), q0[3:], center_of_mass(q0)[0],
+                                   stance_right=stance_right, liftoff_angle=liftoff)
     simulator.Initialize()
     t = time.perf_counter()
     simulator.AdvanceTo(duration)
@@ -182,12 +183,11 @@ def python_floor(distance: float, repeats: int) -> dict:
     ref = run_episode(config, record_trajectory=True)
     times, torques = ref.trajectory["time"], ref.trajectory["actuation"]
     duration = float(times[-1])
-    _, stance_right, liftoff = initial_state(config)[1:]
     variants = {
         "plant alone": lambda: None,
         "+ empty Python update": lambda: EmptyUpdate(1e-3),
         "+ the controller's I/O only": lambda: EmptyUpdate(1e-3, io=True),
-        "+ the controller": lambda: CpgWalkingController(config, stance_right, liftoff),
+        "+ the controller": lambda: CpgWalkingController(config),
     }
     samples: dict[str, list[float]] = {name: [] for name in variants}
     for _ in range(repeats):

@@ -665,11 +665,13 @@ class _PlantDynamics:
 class CpgWalkingController(LeafSystem):
     """CPG + torque-free gate + hip PID + knee/ankle/stance logic for the 7-link biped."""
 
-    def __init__(self, config: EpisodeConfig, initial_stance_right: bool, initial_liftoff_angle: float,
-                 body: np.ndarray = TABLE_I_BODY, plant=None):
-        """`body`: the model's body (kinematics.BODY, `model.body_of`), for the legs' points and the centre of
-        mass. `plant`: the diagram's MultibodyPlant, whose dynamics the hip motor (GaitParams.hip_drive
-        "motor") reads at each update through a context of its own (None: no motor)."""
+    def __init__(self, config: EpisodeConfig, body: np.ndarray = TABLE_I_BODY, plant=None):
+        """`config`: the structure (`structure_key`) and the default context's numbers; an episode's numbers
+        and initial conditions (first stance leg, lift-off angle, phase) are set in its context
+        (`set_episode`, `set_initial_state`), so one system serves every episode of its structure. `body`:
+        the model's body (kinematics.BODY, `model.body_of`), for the legs' points and the centre of mass.
+        `plant`: the diagram's MultibodyPlant, whose dynamics the hip motor (GaitParams.hip_drive "motor")
+        reads at each update through a context of its own (None: no motor)."""
         super().__init__()
         self._dyn = np.zeros(DYN_SIZE)
         self._dynamics = None if plant is None else _PlantDynamics(plant, body)
@@ -688,9 +690,7 @@ class CpgWalkingController(LeafSystem):
 
         self._plant_state = self.DeclareVectorInputPort("plant_state", 18)
         initial = np.zeros(N_STATE)
-        initial[STANCE_RIGHT] = 1.0 if initial_stance_right else 0.0
-        initial[CONTACT_RIGHT] = initial[STANCE_RIGHT]
-        initial[LIFTOFF_ANGLE] = initial_liftoff_angle
+        initial[STANCE_RIGHT] = initial[CONTACT_RIGHT] = 1.0  # until set_initial_state sets the episode's
         initial[TARGET_X] = math.inf
         initial[PREV_CLEARANCE] = math.inf
         initial[PREV_RATES : PREV_RATES + 2] = math.nan

@@ -100,9 +100,7 @@ def build_diagram(
     handles = add_biped(builder, config.ground, config.sim.time_step_s, config.model,
                         contact_approximation=config.sim.contact_approximation, contact=config.contact)
     plant = handles.plant
-    _, _, stance_right, liftoff = initial_state(config, handles.body)
-    controller = builder.AddNamedSystem("cpg_controller",
-                                        CpgWalkingController(config, stance_right, liftoff, handles.body, plant))
+    controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, handles.body, plant))
     builder.Connect(plant.get_state_output_port(), controller.get_input_port_plant_state())
     builder.Connect(controller.get_output_port_actuation(), plant.get_actuation_input_port())
     if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:

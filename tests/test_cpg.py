@@ -80,11 +80,11 @@ def _controller_alone(config):
     q[1] += 0.05
     q[3] = -0.3  # left (swing) hip behind: its foot is also behind, so touchdown cannot be accepted
     q[4] = 0.6
-    c = ctl.CpgWalkingController(config, stance_right, liftoff)
+    c = ctl.CpgWalkingController(config)
     sim = Simulator(c)
     ctx = sim.get_mutable_context()
     c.get_input_port_plant_state().FixValue(ctx, np.concatenate([q, v * 0.0]))
-    c.set_initial_state(ctx, q[3:], 0.0)
+    c.set_initial_state(ctx, q[3:], 0.0, stance_right=stance_right, liftoff_angle=liftoff)
     return c, sim, ctx
 
 

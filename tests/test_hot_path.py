@@ -166,7 +166,7 @@ def test_cache_builds_a_new_diagram_for_a_new_structure():
 
 def test_controller_refuses_a_config_of_another_structure():
     config = _config()
-    c = ctl.CpgWalkingController(config, True, 0.0)
+    c = ctl.CpgWalkingController(config)
     context = c.CreateDefaultContext()
     c.set_episode(context, config.replace(window=TorqueFreeWindow(0.1, 0.3)))  # numbers only: fine
     assert c.law(context)[ctl.L_T1] == 0.1 and c.law(c.CreateDefaultContext())[ctl.L_T1] == config.window.start_s
