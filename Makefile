@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 OUT ?= out
 
-.PHONY: setup reproduce walk test test-slow lint format window-map bench package-check clean docs-figures
+.PHONY: setup reproduce walk test test-slow lint format window-map bench package-check clean docs-figures docs-tables
 
 setup: $(VENV)/.installed
 
@@ -48,6 +48,10 @@ window-map: setup
 # The pictures under docs/, drawn again from the committed records (tests/test_docs_figures.py checks them).
 docs-figures: setup
 	$(PY) benchmarks/docs_figures.py --out docs
+
+# docs/PARAMETERS.md, the controller's parameters slot by slot, from their declarations (tests/test_parameters.py).
+docs-tables: setup
+	$(PY) -c "from drake_biped.controller import parameter_markdown; print(parameter_markdown(), end='')" > docs/PARAMETERS.md
 
 # Speed and time-step benchmarks (about 8 minutes on 2 cores): Markdown + JSON in out/bench, out/time-step-study.
 bench: setup

@@ -53,11 +53,9 @@ from drake_biped.gait import (
     clip,
     hip_servo_torque_k,
     is_touchdown_k,
-    knee_law,
     placement_feedback_k,
     swing_knee_torque_over_k,
     torso_torque_k,
-    touchdown_rule,
 )
 from drake_biped.jit import njit
 from drake_biped.kinematics import (
@@ -71,7 +69,15 @@ from drake_biped.kinematics import (
 )
 from drake_biped.layout import Field, VectorLayout
 from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
-from drake_biped.params import EpisodeConfig
+from drake_biped.params import (
+    CpgParams,
+    EpisodeConfig,
+    GaitParams,
+    Ground,
+    SimulationParams,
+    TorqueFreeWindow,
+    parameter_info,
+)
 
 # The "controller_state" discrete group, declared once; the update below uses the offsets generated here.
 CONTROLLER_STATE = VectorLayout("controller_state", (
@@ -171,29 +177,67 @@ def touchdown_capacity(config: EpisodeConfig) -> int:
 
 # The episode's numbers as the compiled update takes them: one vector, packed by law_vector() into the context's
 # numeric parameter when an episode is set (`set_episode`), read in the kernel through the constants below.
-LAW = VectorLayout("law", (
-    Field("update_period_s", 1, "the controller's update period (s): the plant step under the paper's clock, else the fixed-rate loop's"),
-    Field("state_lag_s", 1, "the plant step: the state read at update time t is the state at t + lag"),
-    Field("alpha", 1, "CPG alpha"), Field("u_a", 1, "CPG u_a"), Field("u_eta", 1, "CPG u_eta"),
-    Field("u_r", 1, "CPG u_r"), Field("kappa", 1, "CPG kappa"),
-    Field("swing_amplitude_rad", 1, "alpha u_a / u_r"),
-    Field("integrated", 1, "1.0 for swing_reading 'integrated', 0.0 for 'anchored'"),
-    Field("predicted_swap", 1, "1.0 for swap_timing 'predicted', 0.0 for 'update'"),
-    Field("entrained", 1, "1.0 for phase_reading 'entrained', 0.0 for 'reset'"),
-    Field("swing_offset_rad", 1, ""), Field("hip_kp", 1, ""), Field("hip_kd", 1, ""), Field("hip_ki", 1, ""),
-    Field("placement_gain", 1, ""), Field("placement_velocity_gain", 1, ""),
-    Field("torso_kp", 1, ""), Field("torso_kd", 1, ""), Field("torso_pitch_rad", 1, ""),
-    Field("knee_law", 7, "gait.knee_law(): the swing knee's thresholds and torques"),
-    Field("stance_knee_torque", 1, ""), Field("ankle_kp", 1, ""), Field("ankle_kd", 1, ""),
-    Field("touchdown_rule", 4, "gait.touchdown_rule(): the touchdown conditions' thresholds"),
-    Field("window_start_s", 1, "t1"), Field("window_end_s", 1, "t2"), Field("window_first_step", 1, ""),
-    Field("ground_slope_rad", 1, ""), Field("ground_tan_slope", 1, "tan of the slope"),
-    Field("ground_level_length_m", 1, "level ground before the slope (NaN: the slope everywhere)"),
-    Field("fall_hip_height_m", 1, ""), Field("fall_pitch_rad", 1, ""),
-    Field("hip_motor", 1, "1.0 for hip_drive 'motor' (zeta the hip joint's velocity, reached each update)"),
-    Field("inter_leg", 1, "1.0 for hip_joint 'inter_leg'"),
-    Field("motor_limit_nm", 1, "the hip motor's maximum torque (N*m)"),
-))
+# What the Context parameter copies from the episode's configuration, one slot each, in order: (section,
+# field, the slot's name). Each field's doc, unit and bounds are its declaration in params (`param`).
+LAW_COPIED = (
+    *(("cpg", n, n) for n in ("alpha", "u_a", "u_eta", "u_r", "kappa")),
+    *(("gait", n, n) for n in ("swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain",
+                               "placement_velocity_gain", "torso_kp", "torso_kd", "torso_pitch_rad")),
+    # the swing knee's law, in swing_knee_torque_k's order (gait.knee_law)
+    *(("gait", n, n) for n in ("knee_extend_phase", "knee_extend_thigh_rad", "knee_flex_max_rad",
+                               "knee_flex_until_phase", "knee_flex_torque", "knee_extend_torque",
+                               "knee_hold_torque")),
+    *(("gait", n, n) for n in ("stance_knee_torque", "ankle_kp", "ankle_kd")),
+    # the touchdown's conditions, in is_touchdown_k's order (gait.touchdown_rule)
+    *(("gait", n, n) for n in ("touchdown_min_step_s", "touchdown_height_m", "touchdown_min_advance_m",
+                               "touchdown_min_phase")),
+    ("window", "start_s", "window_start_s"), ("window", "end_s", "window_end_s"),
+    ("window", "first_step", "window_first_step"),
+    ("ground", "slope_rad", "ground_slope_rad"), ("ground", "level_length_m", "ground_level_length_m"),
+    ("sim", "fall_hip_height_m", "fall_hip_height_m"), ("sim", "fall_pitch_rad", "fall_pitch_rad"),
+    ("gait", "motor_limit_nm", "motor_limit_nm"),
+)
+_SECTION_TYPES = {"cpg": CpgParams, "gait": GaitParams, "window": TorqueFreeWindow, "ground": Ground,
+                  "sim": SimulationParams}
+
+
+def _copied(section: str, name: str, slot: str | None = None) -> Field:
+    """The LAW slot that copies params section `section`'s field `name`, declared there."""
+    info = parameter_info(_SECTION_TYPES[section], name)
+    doc = f"{_SECTION_TYPES[section].__name__}.{name}: {info['doc']}"
+    if section == "ground" and name == "level_length_m":
+        doc += " (NaN for None)"
+    if section == "gait" and name == "touchdown_min_phase":
+        doc += " (-inf under phase_reading 'entrained': the phase does not follow the steps)"
+    return Field(slot or name, 1, doc, info["unit"], info["bounds"])
+
+
+_DERIVED = {  # the slots computed from the configuration, before and among the copied ones
+    "update_period_s": Field("update_period_s", 1, "the controller's update period: the plant step under the "
+                             "paper's clock, else the fixed-rate loop's (SimulationParams.update_period_s)", "s"),
+    "state_lag_s": Field("state_lag_s", 1, "the plant step: the state read at update time t is the state at "
+                         "t + lag (SimulationParams.time_step_s)", "s"),
+    "swing_amplitude_rad": Field("swing_amplitude_rad", 1, "alpha u_a / u_r (CpgParams.swing_amplitude_rad)", "rad"),
+    "integrated": Field("integrated", 1, "1 for GaitParams.swing_reading 'integrated', 0 for 'anchored'", "1"),
+    "predicted_swap": Field("predicted_swap", 1, "1 for GaitParams.swap_timing 'predicted', 0 for 'update'", "1"),
+    "entrained": Field("entrained", 1, "1 for GaitParams.phase_reading 'entrained', 0 for 'reset'", "1"),
+    "ground_tan_slope": Field("ground_tan_slope", 1, "tan(Ground.slope_rad)", "1"),
+    "hip_motor": Field("hip_motor", 1, "1 for GaitParams.hip_drive 'motor' (zeta the hip joint's velocity, "
+                       "reached each update), 0 for 'servo'", "1"),
+    "inter_leg": Field("inter_leg", 1, "1 for GaitParams.hip_joint 'inter_leg', 0 for 'swing'", "1"),
+}
+_COPIED = {slot: _copied(section, name, slot) for section, name, slot in LAW_COPIED}
+# The controller's numbers for one episode, a numeric parameter of its Context: every slot with its doc, unit
+# and bounds (docs/PARAMETERS.md is generated from it: `parameter_markdown`).
+LAW = VectorLayout("law", tuple(({**_DERIVED, **_COPIED})[name] for name in (
+    "update_period_s", "state_lag_s", "alpha", "u_a", "u_eta", "u_r", "kappa", "swing_amplitude_rad",
+    "integrated", "predicted_swap", "entrained", "swing_offset_rad", "hip_kp", "hip_kd", "hip_ki",
+    "placement_gain", "placement_velocity_gain", "torso_kp", "torso_kd", "torso_pitch_rad",
+    "knee_extend_phase", "knee_extend_thigh_rad", "knee_flex_max_rad", "knee_flex_until_phase", "knee_flex_torque",
+    "knee_extend_torque", "knee_hold_torque", "stance_knee_torque", "ankle_kp", "ankle_kd",
+    "touchdown_min_step_s", "touchdown_height_m", "touchdown_min_advance_m", "touchdown_min_phase",
+    "window_start_s", "window_end_s", "window_first_step", "ground_slope_rad", "ground_tan_slope",
+    "ground_level_length_m", "fall_hip_height_m", "fall_pitch_rad", "hip_motor", "inter_leg", "motor_limit_nm")))
 _o = LAW.offset
 L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("update_period_s", "state_lag_s", "alpha", "u_a",
                                                                     "u_eta", "u_r", "kappa"))
@@ -203,8 +247,8 @@ L_ENTRAINED = _o("entrained")
 L_HIP_KP, L_HIP_KD, L_HIP_KI, L_PLACE, L_PLACE_V = (_o(n) for n in ("hip_kp", "hip_kd", "hip_ki", "placement_gain",
                                                                    "placement_velocity_gain"))
 L_TORSO_KP, L_TORSO_KD, L_TORSO_PITCH, L_KNEE, L_STANCE_KNEE = (_o(n) for n in (
-    "torso_kp", "torso_kd", "torso_pitch_rad", "knee_law", "stance_knee_torque"))
-L_ANKLE_KP, L_ANKLE_KD, L_TOUCHDOWN = _o("ankle_kp"), _o("ankle_kd"), _o("touchdown_rule")
+    "torso_kp", "torso_kd", "torso_pitch_rad", "knee_extend_phase", "stance_knee_torque"))
+L_ANKLE_KP, L_ANKLE_KD, L_TOUCHDOWN = _o("ankle_kp"), _o("ankle_kd"), _o("touchdown_min_step_s")
 L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_first_step")
 L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
 L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
@@ -221,41 +265,39 @@ DYN_SIZE = DYN_F + 9
 
 
 def law_vector(config: EpisodeConfig) -> np.ndarray:
-    """The LAW vector of an episode's configuration."""
-    g, c, w, ground, sim = config.gait, config.cpg, config.window, config.ground, config.sim
+    """The LAW vector of an episode's configuration: the derived slots, then every LAW_COPIED field."""
+    g, c, ground, sim = config.gait, config.cpg, config.ground, config.sim
     v = np.zeros(LAW.size)
 
     def put(name: str, value) -> None:
-        v[LAW.slice(name)] = value
+        v[LAW.offset(name)] = value
 
+    for section, name, slot in LAW_COPIED:
+        value = getattr(getattr(config, section), name)
+        put(slot, math.nan if value is None else value)
     put("update_period_s", sim.update_period_s)
     put("state_lag_s", sim.time_step_s)
-    for name in ("alpha", "u_a", "u_eta", "u_r", "kappa"):
-        put(name, getattr(c, name))
     put("swing_amplitude_rad", c.swing_amplitude_rad)
     put("integrated", 1.0 if g.swing_reading == "integrated" else 0.0)
     put("predicted_swap", 1.0 if g.swap_timing == "predicted" else 0.0)
     put("entrained", 1.0 if g.phase_reading == "entrained" else 0.0)
-    for name in ("swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain", "placement_velocity_gain",
-                 "torso_kp", "torso_kd", "torso_pitch_rad", "stance_knee_torque", "ankle_kp", "ankle_kd"):
-        put(name, getattr(g, name))
-    put("knee_law", knee_law(g))
-    rule = touchdown_rule(g)
     if g.phase_reading == "entrained":  # the phase does not follow the steps: no phase condition
-        rule = (*rule[:3], -math.inf)
-    put("touchdown_rule", rule)
-    put("window_start_s", w.start_s)
-    put("window_end_s", w.end_s)
-    put("window_first_step", w.first_step)
-    put("ground_slope_rad", ground.slope_rad)
+        put("touchdown_min_phase", -math.inf)
     put("ground_tan_slope", math.tan(ground.slope_rad))
-    put("ground_level_length_m", math.nan if ground.level_length_m is None else ground.level_length_m)
-    put("fall_hip_height_m", sim.fall_hip_height_m)
-    put("fall_pitch_rad", sim.fall_pitch_rad)
     put("hip_motor", 1.0 if g.hip_drive == "motor" else 0.0)
     put("inter_leg", 1.0 if g.hip_joint == "inter_leg" else 0.0)
-    put("motor_limit_nm", g.motor_limit_nm)
     return v
+
+
+def parameter_markdown() -> str:
+    """docs/PARAMETERS.md: the controller's Context parameter (LAW), slot by slot, from its declarations."""
+    return ("# The controller's parameters\n\n"
+            "Generated from the code (`make docs-tables`; tests/test_parameters.py checks it is current). The "
+            "controller's numbers for one episode are one numeric parameter of its Drake Context, `LAW` in "
+            "drake_biped/controller.py: the slots that copy a field of the episode's configuration take its "
+            "declaration in drake_biped/params.py (`param`: default, unit, bounds, meaning); the others are "
+            "computed from it. Unit `1`: dimensionless (a gain ratio, a flag 1 or 0, a count of steps).\n\n"
+            + LAW.markdown())
 
 
 # The kernel's return code: bits for what the Python side must do after it.

@@ -18,11 +18,14 @@ __all__ = ["Field", "VectorLayout"]
 
 @dataclass(frozen=True)
 class Field:
-    """One field: its name, its number of slots, what it holds (with its unit)."""
+    """One field: its name, its number of slots, what it holds, its unit ("1" for a pure number, "" for a flag
+    or a count) and its bounds (None: unbounded or not declared)."""
 
     name: str
     size: int
     doc: str
+    unit: str = ""
+    bounds: tuple[float | None, float | None] | None = None
 
 
 class VectorLayout:
@@ -71,6 +74,20 @@ class VectorLayout:
         of samples for a scalar field, (samples, size) for a vector field."""
         block = np.asarray(data)[self.slice(name)]
         return block[0].copy() if self._by_name[name].size == 1 else block.T.copy()
+
+    def markdown(self) -> str:
+        """The layout as a Markdown table: slot, name, unit, bounds, meaning."""
+        def bounds(f: Field) -> str:
+            if f.bounds is None or f.bounds == (None, None):
+                return ""
+            lo, hi = f.bounds
+            return f"[{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]"
+
+        rows = ["| slot | name | unit | bounds | meaning |", "|---|---|---|---|---|"]
+        for f in self.fields:
+            slot = str(self.offset(f.name)) if f.size == 1 else f"{self.offset(f.name)}-{self.offset(f.name) + f.size - 1}"
+            rows.append(f"| {slot} | `{f.name}` | {f.unit or '-'} | {bounds(f)} | {f.doc.replace('|', '/')} |")
+        return "\n".join(rows) + "\n"
 
     def describe(self) -> str:
         """The layout as a table: offset, size, name, meaning."""

@@ -22,7 +22,7 @@ from drake_biped.paper import (
 )
 
 __all__ = [
-    "ContactParams", "CpgParams", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
+    "ContactParams", "CpgParams", "param", "parameter_info", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
     "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "LEARNED_WINDOW_S", "RobotModel",
@@ -61,9 +61,28 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+def param(default: Any, unit: str, doc: str, lo: float | None = None, hi: float | None = None) -> Any:
+    """A parameter declared once: its default, its unit ("1" for a pure number, "" for a choice or a flag),
+    what it means and its bounds (None: unbounded on that side), as Drake's named vectors declare theirs. The
+    dataclass checks the bounds; the controller's Context parameter (controller.LAW) and docs/PARAMETERS.md
+    read the unit and the text from here."""
+    return field(default=default, metadata={"unit": unit, "doc": doc, "bounds": (lo, hi)})
+
+
+def parameter_info(cls: type, name: str) -> dict[str, Any]:
+    """The declaration of `cls`'s field `name` (`param`): its unit, doc and bounds."""
+    for f in fields(cls):
+        if f.name == name:
+            if "doc" not in f.metadata:
+                raise KeyError(f"{cls.__name__}.{name} is not declared with param()")
+            return dict(f.metadata)
+    raise KeyError(f"{cls.__name__} has no field {name!r}")
+
+
 class _Validated:
     """Mixin: every field is checked against its declared type after init (an int given for a float is
-    stored as a float), and every number against `_RANGES` (name -> (lo, hi)) or for being finite."""
+    stored as a float), and every number against its declared bounds (`param`; `_RANGES`, name -> (lo, hi),
+    for the sections that declare none) or for being finite."""
 
     _RANGES: dict[str, tuple[float | None, float | None]] = {}
 
@@ -92,8 +111,9 @@ class _Validated:
                         else "")
                 raise ParameterError(f"{owner}.{f.name} must be a {kind}, got {type(value).__name__} "
                                      f"{value!r}{hint}")
-            if f.name in self._RANGES:
-                _check_range(owner, f.name, value, *self._RANGES[f.name])
+            bounds = f.metadata.get("bounds") or self._RANGES.get(f.name)
+            if bounds is not None and _is_number(value):
+                _check_range(owner, f.name, value, *bounds)
             elif isinstance(value, float):
                 _check_finite(owner, f.name, value)
 
@@ -150,20 +170,12 @@ class CpgParams(_Validated):
     reduces to eq. 3 for the paper's alpha = 1, u_eta = 0.
     """
 
-    alpha: float = 1.0
-    u_a: float = 2.0
-    u_eta: float = 0.0
-    u_r: float = 2.1
-    kappa: float = 1.8
-
     # Table IV's grid-search ranges bound what the toolkit accepts, widened for u_a and u_r.
-    _RANGES = {
-        "alpha": (-2.0, 2.0),
-        "u_a": (0.0, 20.0),
-        "u_eta": (-1.0, 1.0),
-        "u_r": (1e-3, 30.0),
-        "kappa": (-10.0, 10.0),
-    }
+    alpha: float = param(1.0, "1", "CPG output gain alpha (Table III)", -2.0, 2.0)
+    u_a: float = param(2.0, "rad/s", "CPG amplitude u_a: zeta = alpha u_a sin(gamma) + u_eta", 0.0, 20.0)
+    u_eta: float = param(0.0, "rad/s", "CPG offset u_eta added to zeta", -1.0, 1.0)
+    u_r: float = param(2.1, "rad/s", "CPG phase rate u_r: d(gamma)/dt = u_r + kappa (stance ankle rate)", 1e-3, 30.0)
+    kappa: float = param(1.8, "1", "CPG feedback gain kappa on the stance ankle's angular velocity", -10.0, 10.0)
 
     @property
     def swing_amplitude_rad(self) -> float:
@@ -214,87 +226,59 @@ class GaitParams(_Validated):
     torque is exactly zero under every drive.
     """
 
-    # How zeta drives the swing (above): "anchored" or "integrated".
-    swing_reading: str = "anchored"
-    # What a touchdown does to the CPG (above): "reset" or "entrained".
-    phase_reading: str = "reset"
-    # When the roles' torques swap at a touchdown: "predicted", at the instant inside the control period
-    # where the swing foot's clearance, extrapolated over the period, crosses the touchdown height (the
-    # period's torques blend the two roles' by the part of it each holds); "update", from the update that
-    # detects the crossing (up to one period late).
-    swap_timing: str = "predicted"
-    # What realizes zeta at the hip (above): "servo" or "motor"; the motor's joint and maximum torque (N*m).
-    hip_drive: str = "servo"
-    hip_joint: str = "swing"
-    motor_limit_nm: float = 40.0
-    # Integrated reading: a constant offset of the swing reference at the end of the half-cycle (rad).
-    swing_offset_rad: float = 0.0
-    # Swing hip: PID servo of the swing thigh's world angle to the CPG reference (angle, zeta).
-    hip_kp: float = 90.0  # N*m/rad
-    hip_kd: float = 11.0  # N*m*s/rad
-    hip_ki: float = 0.0  # N*m/(rad*s)
-    # Foot placement: end-of-swing thigh angle = A + placement_gain * (hip x - stance ankle x)
-    #                 + placement_velocity_gain * (hip x velocity).
-    placement_gain: float = 0.55  # rad/m
-    placement_velocity_gain: float = 0.1  # rad*s/m
-    # Torso: stance-hip PD to a constant pitch (negative = forward lean), minus the swing-hip torque.
-    torso_kp: float = 280.0  # N*m/rad
-    torso_kd: float = 28.0  # N*m*s/rad
-    torso_pitch_rad: float = -0.06
+    swing_reading: str = param("anchored", "", 'how zeta drives the swing (above): "anchored" or "integrated"')
+    phase_reading: str = param("reset", "", 'what a touchdown does to the CPG (above): "reset" or "entrained"')
+    swap_timing: str = param(
+        "predicted", "", 'when the roles\' torques swap at a touchdown: "predicted", at the instant inside the '
+        "control period where the swing foot's clearance, extrapolated over the period, crosses the touchdown "
+        "height (the period's torques blend the two roles' by the part of it each holds); \"update\", from the "
+        "update that detects the crossing (up to one period late)")
+    hip_drive: str = param("servo", "", 'what realizes zeta at the hip (above): "servo" or "motor"')
+    hip_joint: str = param("swing", "", 'the motor\'s joint (above): "swing" or "inter_leg"')
+    motor_limit_nm: float = param(40.0, "N*m", "the hip motor's maximum torque (hip_drive \"motor\")", 0.0, 200.0)
+    swing_offset_rad: float = param(
+        0.0, "rad", "integrated reading: a constant offset of the swing reference at the end of the half-cycle",
+        -1.5, 1.5)
+    hip_kp: float = param(90.0, "N*m/rad", "swing hip servo: gain on the swing thigh's world-angle error", 0.0, 2000.0)
+    hip_kd: float = param(11.0, "N*m*s/rad", "swing hip servo: gain on the rate error (zeta)", 0.0, 200.0)
+    hip_ki: float = param(0.0, "N*m/(rad*s)", "swing hip servo: gain on the angle error's integral", 0.0, 2000.0)
+    placement_gain: float = param(
+        0.55, "rad/m", "foot placement: the end-of-swing thigh angle grows by this times (hip x - stance ankle x)",
+        -5.0, 5.0)
+    placement_velocity_gain: float = param(
+        0.1, "rad*s/m", "foot placement: and by this times the hip's forward velocity", -5.0, 5.0)
+    torso_kp: float = param(280.0, "N*m/rad", "torso: stance-hip PD to a constant pitch, gain on the pitch error",
+                            0.0, 5000.0)
+    torso_kd: float = param(28.0, "N*m*s/rad", "torso: gain on the pitch rate", 0.0, 500.0)
+    torso_pitch_rad: float = param(-0.06, "rad", "torso: the pitch held (negative leans forward)", -0.8, 0.8)
     # Swing knee, bang-bang: flex (below knee_flex_max_rad) until the CPG phase passes
     # knee_flex_until_phase, then passive, then extend once the phase passes knee_extend_phase and the
-    # thigh is ahead by knee_extend_thigh_rad, until touchdown.
-    # Stance knee: constant extending torque.
-    knee_flex_torque: float = 4.4  # N*m
-    knee_extend_torque: float = 9.3  # N*m
-    knee_extend_phase: float = 1.64  # rad of CPG phase
-    knee_flex_max_rad: float = 0.48
-    # Clearance guard: the knee extends only once the swing thigh is this far ahead of vertical (rad),
-    # so a swing slowed by the torque-free period does not put its toe into the ground mid-swing.
-    knee_extend_thigh_rad: float = -1.0
-    # Flexing stops once the CPG phase passes this (rad); from there until extension the knee is
-    # passive (zero torque), swinging as in ballistic walking. pi: flex until extension.
-    knee_flex_until_phase: float = math.pi
-    # The swing knee's torque in that passive middle (N*m, positive flexes): 0 leaves the knee free; a
-    # small flexing torque keeps the shank from taking the thigh's momentum while the thigh coasts, so
-    # the foot stays up until the extension (which still needs the phase and the thigh guard).
-    knee_hold_torque: float = 0.0
-    stance_knee_torque: float = 17.7  # N*m
-    # Ankles: PD keeping each foot parallel to the local ground.
-    ankle_kp: float = 20.0  # N*m/rad
-    ankle_kd: float = 0.3  # N*m*s/rad
-    # Touchdown (stance/swing swap) is accepted only when all hold.
-    touchdown_min_step_s: float = 0.15
-    touchdown_height_m: float = 0.002
-    touchdown_min_advance_m: float = 0.05
-    touchdown_min_phase: float = 1.0  # rad of CPG phase
-
-    _RANGES = {
-        "hip_kp": (0.0, 2000.0),
-        "hip_kd": (0.0, 200.0),
-        "hip_ki": (0.0, 2000.0),
-        "placement_gain": (-5.0, 5.0),
-        "placement_velocity_gain": (-5.0, 5.0),
-        "torso_kp": (0.0, 5000.0),
-        "torso_kd": (0.0, 500.0),
-        "torso_pitch_rad": (-0.8, 0.8),
-        "knee_flex_torque": (0.0, 30.0),
-        "knee_extend_torque": (0.0, 30.0),
-        "knee_extend_phase": (0.0, math.pi),
-        "knee_flex_max_rad": (0.0, 2.4),
-        "knee_extend_thigh_rad": (-1.0, 1.0),
-        "knee_flex_until_phase": (0.0, math.pi),
-        "knee_hold_torque": (-30.0, 30.0),
-        "stance_knee_torque": (0.0, 30.0),
-        "ankle_kp": (0.0, 500.0),
-        "ankle_kd": (0.0, 50.0),
-        "touchdown_min_step_s": (0.0, 5.0),
-        "touchdown_height_m": (0.0, 0.05),
-        "touchdown_min_advance_m": (-0.5, 0.5),
-        "touchdown_min_phase": (0.0, math.pi),
-        "swing_offset_rad": (-1.5, 1.5),
-        "motor_limit_nm": (0.0, 200.0),
-    }
+    # thigh is ahead by knee_extend_thigh_rad, until touchdown. Stance knee: constant extending torque.
+    knee_flex_torque: float = param(4.4, "N*m", "swing knee: the flexing torque", 0.0, 30.0)
+    knee_extend_torque: float = param(9.3, "N*m", "swing knee: the extending torque", 0.0, 30.0)
+    knee_extend_phase: float = param(1.64, "rad", "swing knee: extends once the CPG phase passes this", 0.0, math.pi)
+    knee_flex_max_rad: float = param(0.48, "rad", "swing knee: flexes while its angle is below this", 0.0, 2.4)
+    knee_extend_thigh_rad: float = param(
+        -1.0, "rad", "swing knee: extends only once the swing thigh is this far ahead of vertical (a clearance "
+        "guard: a swing slowed by the torque-free period does not put its toe into the ground mid-swing)",
+        -1.0, 1.0)
+    knee_flex_until_phase: float = param(
+        math.pi, "rad", "swing knee: flexing stops once the CPG phase passes this; from there until extension "
+        "the knee is passive, as in ballistic walking (pi: flex until extension)", 0.0, math.pi)
+    knee_hold_torque: float = param(
+        0.0, "N*m", "swing knee: its torque in that passive middle (positive flexes; 0 leaves it free)",
+        -30.0, 30.0)
+    stance_knee_torque: float = param(17.7, "N*m", "stance knee: the constant extending torque", 0.0, 30.0)
+    ankle_kp: float = param(20.0, "N*m/rad", "ankles: PD keeping each foot parallel to the local ground, gain",
+                            0.0, 500.0)
+    ankle_kd: float = param(0.3, "N*m*s/rad", "ankles: rate gain", 0.0, 50.0)
+    # Touchdown (stance/swing swap) is accepted only when all of these hold.
+    touchdown_min_step_s: float = param(0.15, "s", "touchdown: at least this long after the last one", 0.0, 5.0)
+    touchdown_height_m: float = param(0.002, "m", "touchdown: the swing foot's clearance is below this",
+                                      0.0, 0.05)
+    touchdown_min_advance_m: float = param(
+        0.05, "m", "touchdown: the swing ankle is at least this far ahead of the stance ankle", -0.5, 0.5)
+    touchdown_min_phase: float = param(1.0, "rad", "touchdown: the CPG phase has passed this", 0.0, math.pi)
 
     SWING_READINGS = ("anchored", "integrated")
     SWAP_TIMINGS = ("predicted", "update")
@@ -329,12 +313,12 @@ class InitialConditions(_Validated):
     0.175 m/s: an inverted pendulum of 0.6 m needs 0.33 m/s for that; as the angle between the
     thighs it needs 0.166 m/s.)"""
 
-    hip_angle_rad: float = INITIAL_HIP_ANGLE_RAD
-    speed_mps: float = INITIAL_SPEED_MPS
-    # The CPG phase gamma the first swing starts from (rad; not printed: 0 starts a whole half-cycle).
-    cpg_phase_rad: float = 0.0
-
-    _RANGES = {"hip_angle_rad": (0.0, 0.9), "speed_mps": (-2.0, 3.0), "cpg_phase_rad": (0.0, math.pi)}
+    hip_angle_rad: float = param(INITIAL_HIP_ANGLE_RAD, "rad", "the angle between the thighs at the start",
+                                 0.0, 0.9)
+    speed_mps: float = param(INITIAL_SPEED_MPS, "m/s", "every body's forward speed at the start", -2.0, 3.0)
+    cpg_phase_rad: float = param(
+        0.0, "rad", "the CPG phase gamma the first swing starts from (not printed: 0 starts a whole half-cycle)",
+        0.0, math.pi)
 
 
 @dataclass(frozen=True)
@@ -343,14 +327,12 @@ class TorqueFreeWindow(_Validated):
 
     end_s <= start_s means no window (the paper's convention t2 <= t1)."""
 
-    start_s: float = 0.0
-    end_s: float = 0.0
-    # The window acts from step `first_step` on. Step 0 is the initiation (from the initial state to
-    # the first touchdown T_1); the paper's controller, and so its torque-free period, is about the
-    # maintenance phase that follows.
-    first_step: int = 1
-
-    _RANGES = {"start_s": (0.0, 10.0), "end_s": (0.0, 10.0)}
+    start_s: float = param(0.0, "s", "t1: the hip's torque is zero from this long after each step's start",
+                           0.0, 10.0)
+    end_s: float = param(0.0, "s", "t2: until this long after it (t2 <= t1: no window)", 0.0, 10.0)
+    # Step 0 is the initiation (from the initial state to the first touchdown T_1); the paper's controller,
+    # and so its torque-free period, is about the maintenance phase that follows.
+    first_step: int = param(1, "1", "the window acts from this step on (0: the initiation too)", 0, None)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -379,16 +361,14 @@ class Ground(_Validated):
 
     slope_rad > 0 ascends in +x. A piecewise ground (level_length_m set) must ascend."""
 
-    slope_rad: float = 0.0
-    level_length_m: float | None = None
-    friction: float = 1.0
-
-    _RANGES = {"slope_rad": (-0.3, 0.3), "friction": (0.05, 5.0)}
+    slope_rad: float = param(0.0, "rad", "the ground's slope (> 0 ascends in +x)", -0.3, 0.3)
+    level_length_m: float | None = param(None, "m", "level ground for this long, then the slope (None: the "
+                                         "slope everywhere)", 0.0, 1000.0)
+    friction: float = param(1.0, "1", "the ground's Coulomb friction coefficient", 0.05, 5.0)
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.level_length_m is not None:
-            _check_range("Ground", "level_length_m", self.level_length_m, 0.0, 1000.0)
             if self.slope_rad < 0:
                 raise ParameterError(
                     f"Ground.slope_rad = {self.slope_rad!r}: a level-then-slope ground must ascend (>= 0)"
@@ -423,25 +403,18 @@ class SimulationParams(_Validated):
     under it, and it must be a whole multiple of the step. A record holds both the reading and the rate
     (`to_dict`: "controller_clock" and "update_period_s")."""
 
-    time_step_s: float = 1e-3
-    control_period_s: float | None = None
-    distance_m: float = 10.0
-    max_time_s: float = 60.0
-    # Fall: hip below this height above the ground, or torso pitch beyond this angle.
-    fall_hip_height_m: float = 0.35
-    fall_pitch_rad: float = 1.0
-    # Drake's discrete contact approximation. SAP was chosen by measurement (benchmarks/bench.py):
-    # "similar" and "lagged" walk but are no faster, and the gait falls within half a metre under "tamsi".
-    contact_approximation: str = "sap"
-
-    _RANGES = {
-        "time_step_s": (1e-5, 0.02),
-        "control_period_s": (1e-5, 0.05),
-        "distance_m": (1e-3, 1e4),
-        "max_time_s": (1e-3, 1e5),
-        "fall_hip_height_m": (0.0, 0.6),
-        "fall_pitch_rad": (0.05, math.pi),
-    }
+    time_step_s: float = param(1e-3, "s", "the plant's time step", 1e-5, 0.02)
+    control_period_s: float | None = param(
+        None, "s", "the controller's update period as a fixed-rate loop (None: the controller acts at every "
+        "plant step, the paper's clock)", 1e-5, 0.05)
+    distance_m: float = param(10.0, "m", "the episode ends once the centre of mass has walked this far",
+                              1e-3, 1e4)
+    max_time_s: float = param(60.0, "s", "the episode's simulated time limit", 1e-3, 1e5)
+    fall_hip_height_m: float = param(0.35, "m", "a fall: the hip below this height above the ground", 0.0, 0.6)
+    fall_pitch_rad: float = param(1.0, "rad", "a fall: the torso's pitch beyond this", 0.05, math.pi)
+    # SAP was chosen by measurement (benchmarks/bench.py): "similar" and "lagged" walk but are no faster, and
+    # the gait falls within half a metre under "tamsi".
+    contact_approximation: str = param("sap", "", "Drake's discrete contact approximation")
 
     CONTACT_APPROXIMATIONS = ("sap", "similar", "lagged", "tamsi")
     # The two readings of the controller's clock, as records name them.
