@@ -61,6 +61,7 @@ _API = {
     "Kick": "drake_biped.episode",
     # learning and analysis
     "GarbLearner": "drake_biped.learners.garb",
+    "Learner": "drake_biped.learners.base",
     "make_learner": "drake_biped.learners.registry",
     "register_learner": "drake_biped.learners.registry",
     "reward": "drake_biped.analysis.reward",
@@ -106,6 +107,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerl
     from drake_biped.controller import CpgWalkingController
     from drake_biped.diagram import BipedDiagram, build_diagram
     from drake_biped.episode import EpisodeResult, Kick, StepRecord, run_episode, simulate
+    from drake_biped.learners.base import Learner
     from drake_biped.learners.garb import GarbLearner
     from drake_biped.model import JOINT_NAMES, ModelError, build_plant
     from drake_biped.params import (

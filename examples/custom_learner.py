@@ -2,7 +2,8 @@
 
     python examples/custom_learner.py [--episodes 12] [--distance 10]
 
-A learner is a class with ask() -> (t1, t2), tell(sample, reward), mean, info(), state() and from_state().
+A learner subclasses drake_biped.Learner: ask() -> (t1, t2), tell(sample, reward), mean, info(), state() and
+from_state().
 Registered, it is made by name like the shipped ones, and `drake-biped learn --learner NAME` could use it
 (in a process that has registered it).
 """
@@ -14,7 +15,7 @@ from drake_biped.cli import integer, number, run_script, script_parser  # the co
 
 
 @db.register_learner
-class OnePlusOne:
+class OnePlusOne(db.Learner):
     name = "one-plus-one"
 
     def __init__(self, mean, variance, seed=None):

@@ -10,6 +10,7 @@ from drake_biped.learners import (
     LEARNERS,
     CmaesLearner,
     GarbLearner,
+    Learner,
     PgpeLearner,
     learner_from_state,
     make_learner,
@@ -110,7 +111,7 @@ def test_make_learner_refuses_an_unknown_name():
 
 
 def test_a_registered_learner_is_made_by_name():
-    class RandomSearch:
+    class RandomSearch(Learner):
         name = "random-test"
 
         def __init__(self, mean, variance, seed=None):
@@ -140,5 +141,25 @@ def test_a_registered_learner_is_made_by_name():
         assert np.linalg.norm(learner.mean - OPTIMUM) < 0.1
     finally:
         LEARNERS.pop("random-test", None)
-    with pytest.raises(TypeError, match="not a learner"):
-        register_learner(type("Nothing", (), {"name": "nothing"}))
+    with pytest.raises(TypeError, match="not a subclass of drake_biped.learners.Learner"):
+        register_learner(type("Nothing", (), {"name": "nothing", "ask": None, "tell": None}))
+
+    class Half(Learner):  # declares the interface, implements part of it
+        name = "half-test"
+
+        def ask(self):
+            return np.zeros(2)
+
+    with pytest.raises(TypeError, match=r"Half leaves \['from_state', 'info', 'state', 'tell'\]"):
+        register_learner(Half)
+    assert "half-test" not in LEARNERS
+
+
+def test_every_shipped_learner_declares_the_interface():
+    for name, cls in LEARNERS.items():
+        assert issubclass(cls, Learner) and cls.name == name and not cls.__abstractmethods__
+        learner = cls.from_settings({"mean": [0.4, 0.6], "variance": 0.01, "beta": 0.8,
+                                     "schedule": [[None, 0.01]], "options": {}}, seed=3)
+        np.testing.assert_allclose(learner.mean, [0.4, 0.6])
+        restored = learner_from_state(learner.state())
+        assert type(restored) is cls and np.array_equal(restored.ask(), learner.ask())

@@ -43,7 +43,7 @@ from drake_biped.common.options import (
 )
 from drake_biped.common.walks import REWALK_M, rewalk, window_of
 from drake_biped.learners.garb import GarbLearner
-from drake_biped.learners.registry import learner_from_state, make_learner
+from drake_biped.learners.registry import DEFAULT_LEARNER, learner_class, learner_from_state
 from drake_biped.paper import (
     GARB_BETA,
     GARB_MEAN_S,
@@ -76,18 +76,13 @@ def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
     learner are GARB's."""
     fixed = {k: v for k, v in settings.items() if k not in ("trials", "episodes")}
     if "learner" in fixed and "name" not in fixed["learner"]:
-        fixed["learner"] = {"name": "garb", "options": {}, **fixed["learner"]}
+        fixed["learner"] = {"name": DEFAULT_LEARNER, "options": {}, **fixed["learner"]}
     return fixed
 
 
 def new_learner(learner_settings: dict[str, Any], seed: int):
     """The learner of a run's settings["learner"] (make_settings), seeded `seed`."""
-    ls = learner_settings
-    name = ls.get("name", "garb")
-    options = dict(ls.get("options", {}))
-    if name == "garb":
-        options.update(beta=ls["beta"], schedule=[tuple(b) for b in ls["schedule"]])
-    return make_learner(name, ls["mean"], ls["variance"], seed=seed, **options)
+    return learner_class(learner_settings.get("name", DEFAULT_LEARNER)).from_settings(learner_settings, seed)
 
 
 class Trial:
@@ -110,7 +105,7 @@ class Trial:
             self.learner = learner_from_state(record["learner"])
         elif start is not None:  # a new run from a learned policy (the slope experiment)
             self.episodes = []
-            self.learner = GarbLearner.from_state(start).restarted(seed=trial_seed(settings["seed"], index))
+            self.learner = learner_from_state(start).restarted(seed=trial_seed(settings["seed"], index))
         else:
             self.episodes = []
             self.learner = new_learner(settings["learner"], trial_seed(settings["seed"], index))
@@ -186,7 +181,7 @@ class Trial:
 
 def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
                   mean=(0.5, 0.5), variance: float = 0.04, beta: float = 0.8, schedule=TABLE_II,
-                  learner: str = "garb", options: dict[str, Any] | None = None, force: bool = False
+                  learner: str = DEFAULT_LEARNER, options: dict[str, Any] | None = None, force: bool = False
                   ) -> dict[str, Any]:
     """The settings record of a learning run, checked (ParameterError naming the option), its size bounded
     (`check_learning_size`) before any work."""
@@ -197,10 +192,10 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
     check_learning_size(f"--trials {trials} x --episodes {episodes}", trials * episodes, force)
     if not isinstance(seed, int) or seed < 0:
         raise ParameterError(f"--seed {seed!r}: must be an integer >= 0")
-    GarbLearner(mean, variance, beta, schedule)  # validates
+    GarbLearner(mean, variance, beta, schedule)  # validates what every record holds (beta and schedule: GARB's)
     learner_settings = {"mean": list(map(float, mean)), "variance": float(variance), "beta": float(beta),
                         "schedule": [list(b) for b in schedule]}
-    if learner != "garb" or options:
+    if learner != DEFAULT_LEARNER or options:  # a record names its learner unless it is the default's
         learner_settings.update(name=learner, options=dict(options or {}))
         try:
             new_learner(learner_settings, 0)  # validates the name and the options
@@ -412,7 +407,7 @@ class LearningSettings:
     variance: float = GARB_VARIANCE_S2
     beta: float = GARB_BETA
     schedule: tuple[tuple[int | None, float], ...] = TABLE_II
-    learner: str = "garb"
+    learner: str = DEFAULT_LEARNER
     options: dict[str, Any] = field(default_factory=dict)
     force: bool = False  # run more than MAX_EPISODES episodes
 

@@ -67,9 +67,9 @@ PARSER = dict(help="learning of the torque-free period (Experiment 1: GARB), on 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped learn`'s options."""
     add_episode_options(p)
-    from drake_biped.learners.registry import LEARNERS
+    from drake_biped.learners.registry import DEFAULT_LEARNER, LEARNERS
 
-    p.add_argument("--learner", choices=sorted(LEARNERS), default="garb",
+    p.add_argument("--learner", choices=sorted(LEARNERS), default=DEFAULT_LEARNER,
                    help="'garb' (the paper's, Table II), 'cmaes' (CMA-ES, pycma), 'pgpe' (symmetric PGPE)")
     p.add_argument("--trials", type=count, default=5, help="independent trials")
     p.add_argument("--episodes", type=count, default=500, help="episodes per trial")

@@ -20,10 +20,11 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.learners.base import Learner
 from drake_biped.learners.common import check_seed, restored
 
 
-class CmaesLearner:
+class CmaesLearner(Learner):
     """CMA-ES with ask/tell one episode at a time (see the module docstring)."""
 
     name = "cmaes"

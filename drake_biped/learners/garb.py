@@ -18,11 +18,12 @@ resumed run continues with exactly the samples an uninterrupted one would draw.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
+from drake_biped.learners.base import Learner
 from drake_biped.learners.common import check_seed, restored
 from drake_biped.paper import TABLE_II
 
@@ -57,7 +58,7 @@ def _check_schedule(schedule) -> tuple[tuple[int | None, float], ...]:
     return tuple(out)
 
 
-class GarbLearner:
+class GarbLearner(Learner):
     """Gaussian policy over (t1, t2), updated once per episode (see the module docstring)."""
 
     name = "garb"
@@ -138,6 +139,12 @@ class GarbLearner:
         learner.trace = self.trace.copy()
         learner.baseline = self.baseline
         return learner
+
+    @classmethod
+    def from_settings(cls, settings: Mapping[str, Any], seed: int | None) -> GarbLearner:
+        """GARB of a learning run's settings: its beta and schedule are settings of their own (Table II)."""
+        return cls(settings["mean"], settings["variance"], beta=settings["beta"],
+                   schedule=[tuple(b) for b in settings["schedule"]], seed=seed, **dict(settings.get("options", {})))
 
     @classmethod
     def from_state(cls, state: dict[str, Any]) -> GarbLearner:

@@ -20,10 +20,11 @@ from typing import Any
 
 import numpy as np
 
+from drake_biped.learners.base import Learner
 from drake_biped.learners.common import check_seed, restored
 
 
-class PgpeLearner:
+class PgpeLearner(Learner):
     """Symmetric PGPE over (t1, t2), one episode per ask/tell (see the module docstring)."""
 
     name = "pgpe"
