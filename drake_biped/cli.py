@@ -93,9 +93,6 @@ class _VersionAction(argparse.Action):
         parser.exit()
 
 
-RESUMABLE = ("gait-search", "learn", "compare-learners", "stability", "grid", "slope", "reproduce")
-
-
 # The experiments with a command of their own, in the order `drake-biped --help` lists them.
 EXPERIMENT_COMMANDS = ("walk", "window_map", "gait_search", "time_step", "learning", "compare_learners", "landscape",
                        "stability", "rewalk", "floquet", "bifurcation", "basins", "push_margin", "grid", "slope",
@@ -128,22 +125,9 @@ def build_parser() -> argparse.ArgumentParser:
     for module in experiment_commands():  # each experiment declares its options and runs its command
         command = sub.add_parser(module.COMMAND, **module.PARSER)
         module.add_arguments(command)
-        command.set_defaults(func=module.command)
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
+        # a module's RESUMABLE and GROWABLE: whether rerunning resumes, and the counts that may grow
+        command.set_defaults(func=module.command, resumable=getattr(module, "RESUMABLE", False),
+                             growable=tuple(getattr(module, "GROWABLE", ())))
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
     figs.add_argument("dir", help="the learning run's output folder")
     figs.set_defaults(func=cmd_figures)
@@ -155,13 +139,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-# Counts a resumable command's run is extended by when given larger (never shortened).
-_GROWABLE = {"learn": ("episodes", "trials"), "compare-learners": ("episodes", "trials"),
-             "gait-search": ("generations",), "slope": ("episodes", "trials"), "stability": ("trials",)}
-
 # What does not change a run's records: where it runs and how it reports. Every other option is part of the
 # settings an output folder is held for (records.claim_folder).
-_NOT_SETTINGS = {"out", "workers", "scheduler", "force", "debug", "overwrite", "func", "command", "replot"}
+_NOT_SETTINGS = {"out", "workers", "scheduler", "force", "debug", "overwrite", "func", "command", "replot",
+                 "resumable", "growable"}
 
 
 def _settings_of(args: argparse.Namespace) -> dict:
@@ -188,7 +169,7 @@ def _holding_the_out_folder(args: argparse.Namespace) -> Iterator[None]:
     from drake_biped.records import claim_folder
 
     with claim_folder(Path(out), args.command, _settings_of(args), overwrite=getattr(args, "overwrite", False),
-                      growable=_GROWABLE.get(args.command, ())):
+                      growable=getattr(args, "growable", ())):
         yield
 
 
@@ -214,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     debug = bool(getattr(args, "debug", False)) or os.environ.get(DEBUG_ENV, "") not in ("", "0")
     out = getattr(args, "out", None)
     again = ("run the same command again to resume: finished work is kept in " + str(out)
-             if args.command in RESUMABLE and out else "run the same command again")
+             if getattr(args, "resumable", False) and out else "run the same command again")
     with _failures_as_one_line(f"drake-biped {args.command}", debug, again):
         with _holding_the_out_folder(args):
             return args.func(args)

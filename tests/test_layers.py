@@ -43,6 +43,7 @@ LAYERS = {
     "drake_biped.learners.pgpe": EXPERIMENTS,
     "drake_biped.learners.registry": EXPERIMENTS,
     "drake_biped.learners.common": EXPERIMENTS,
+    "drake_biped.learners.base": EXPERIMENTS,
     "drake_biped.cli": CLI,
     "drake_biped.__main__": CLI,
 }

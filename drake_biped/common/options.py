@@ -328,12 +328,24 @@ def positive_list(text: str) -> list[float]:
     return values
 
 
-def add_window_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default: the gait's own window, "
-                   "else the default gait's learned one (0.3672-0.8629 s)")
-    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); given with --t1")
-    p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
-                   "(the trial with a window and the lowest C_mt)")
+# What a command walks when neither --t1/--t2 nor --policy is given (`add_window_options`).
+WINDOW_DEFAULTS = {
+    "learned": "the gait's own window, else the default gait's learned one (0.3672-0.8629 s)",
+    "gait": "the gait's own window (none when it has none)",
+    "none": "no window",
+}
+
+
+def add_window_options(p: argparse.ArgumentParser, default: str = "learned", policy: bool = True) -> None:
+    """The torque-free window's options, declared once for every command: --t1 and --t2 (s after each step's
+    start), and --policy (a learning run's best learned window) where the command takes one; `default` names
+    what is walked without them (WINDOW_DEFAULTS)."""
+    p.add_argument("--t1", type=number("nonnegative"),
+                   help=f"torque-free start after each step's start (s), with --t2; default: {WINDOW_DEFAULTS[default]}")
+    p.add_argument("--t2", type=number("positive"), help="torque-free end (s), after --t1")
+    if policy:
+        p.add_argument("--policy", default=None, help="a learning.json: use its best learned torque-free period "
+                       "(the trial with a window and the lowest C_mt)")
 
 
 def add_cluster_options(p: argparse.ArgumentParser) -> None:

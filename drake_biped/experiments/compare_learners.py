@@ -182,6 +182,9 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
 
 
 COMMAND = "compare-learners"
+# Rerunning the command on the same --out resumes it from its records, and these counts may be given larger to extend the run (never smaller).
+RESUMABLE = True
+GROWABLE = ("episodes", "trials")
 PARSER = dict(help="learners side by side against the window map's best window")
 
 

@@ -11,10 +11,10 @@ from drake_biped.common.floquet_runs import FloquetSettings, run
 from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
+    add_window_options,
     chosen_window,
     count,
     episode_config,
-    number,
     out_folder,
     positive_list,
     run_command,
@@ -30,9 +30,7 @@ PARSER = dict(help="the gait's periodic orbit (Newton on the full-state step map
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped floquet`'s options."""
     add_episode_options(p)
-    p.add_argument("--t1", type=number("nonnegative"), help="torque-free start (s); default: the gait's window")
-    p.add_argument("--t2", type=number("positive"), help="torque-free end (s); default: the gait's window")
-    p.add_argument("--policy", default=None, help="a learning.json: analyse its best learned torque-free period")
+    add_window_options(p, default="gait")
     p.add_argument("--settle-steps", type=count, default=8,
                    help="touchdowns walked from the initiation before the search starts (default 8)")
     p.add_argument("--epsilons", type=positive_list, default=None,

@@ -917,6 +917,9 @@ def _append(path: Path, record: dict) -> None:
 
 
 COMMAND = "gait-search"
+# Rerunning the command on the same --out resumes it from its records, and these counts may be given larger to extend the run (never smaller).
+RESUMABLE = True
+GROWABLE = ("generations",)
 PARSER = dict(help="evolve gait parameters for walking and torque-free savings",
               epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
 

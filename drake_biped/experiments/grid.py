@@ -366,6 +366,8 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
 
 
 COMMAND = "grid"
+# Rerunning the command on the same --out resumes it from its records.
+RESUMABLE = True
 PARSER = dict(help="grid search of CPG parameters and the initiation (Table IV), on Dask")
 
 

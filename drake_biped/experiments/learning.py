@@ -59,6 +59,9 @@ def summary_lines(record: dict[str, Any], out: Path) -> list[str]:
 
 
 COMMAND = "learn"
+# Rerunning the command on the same --out resumes it from its records, and these counts may be given larger to extend the run (never smaller).
+RESUMABLE = True
+GROWABLE = ("episodes", "trials")
 
 
 PARSER = dict(help="learning of the torque-free period (Experiment 1: GARB), on Dask")

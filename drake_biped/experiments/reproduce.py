@@ -637,6 +637,8 @@ def check_out(out: Path, profile: Profile) -> None:
 
 
 COMMAND = "reproduce"
+# Rerunning the command on the same --out resumes it from its records.
+RESUMABLE = True
 PARSER = dict(help="every experiment of the paper and one report beside its numbers "
               "(--quick: small settings, minutes)")
 

@@ -343,6 +343,9 @@ def run(settings: SlopeSettings, out: Path, client=None, progress: bool = True,
 
 
 COMMAND = "slope"
+# Rerunning the command on the same --out resumes it from its records, and these counts may be given larger to extend the run (never smaller).
+RESUMABLE = True
+GROWABLE = ("episodes", "trials")
 PARSER = dict(help="slope adaptation: does the learned torque-free period climb, does none, "
               "and does online GARB learning adapt it (Figs. 8-11), on Dask")
 

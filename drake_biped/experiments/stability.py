@@ -377,6 +377,9 @@ def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, clie
 
 
 COMMAND = "stability"
+# Rerunning the command on the same --out resumes it from its records, and these counts may be given larger to extend the run (never smaller).
+RESUMABLE = True
+GROWABLE = ("trials",)
 PARSER = dict(help="pushes and Poincare return maps with and without a torque-free "
               "period (Table VI, Fig. 7), on Dask")
 

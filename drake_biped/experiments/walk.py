@@ -18,6 +18,7 @@ from pydrake.systems.framework import Diagram
 from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.common.options import (
     add_episode_options,
+    add_window_options,
     episode_config,
     number,
     out_folder,
@@ -262,9 +263,7 @@ PARSER = dict(help="walk one episode and write its record, figures and animation
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped walk`'s options."""
     add_episode_options(p)
-    p.add_argument("--t1", type=number("nonnegative"),
-                   help="torque-free start after each step start (s); with --t2 (default: no window)")
-    p.add_argument("--t2", type=number("nonnegative"), help="torque-free end (s), after --t1 (default: no window)")
+    add_window_options(p, default="none", policy=False)
     p.add_argument("--push", type=number("finite"), help="horizontal push on the torso (N, + forward) "
                    "(default: none)")
     p.add_argument("--push-start", type=number("nonnegative"), default=0.4, help="push start (s)")
