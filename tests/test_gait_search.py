@@ -545,3 +545,20 @@ def test_hold_fine_judges_the_walk_without_a_window_on_the_time_step_studys_ladd
     del cost[0.125]
     value, detail = gait_search.OBJECTIVES["hold-fine"].score(EpisodeConfig(), base, (), 0)
     assert detail["step_ladder_changes"] is None and value == pytest.approx(0.5 - 1.0)
+
+
+@pytest.mark.parametrize("method", ["es", "cmaes"])
+def test_a_search_stops_once_the_objective_maximum_is_reached(tmp_path, client, method):
+    # "walk" scores every walker 0, its maximum: a start that walks leaves nothing to search for.
+    start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
+    settings = GaitSearchSettings(start, generations=5, offspring=4, sigma=0.3, seed=2, distance_m=0.3,
+                                  objective="walk")
+    search = gait_search.run_cmaes if method == "cmaes" else run
+    result = search(settings, tmp_path, client, progress=False)
+    assert gait_search.OBJECTIVES["walk"].maximum == result["score"] == 0.0
+    assert [r["generation"] for r in _read_log(tmp_path / "search.jsonl")] == [0]
+    # A start that falls is searched: the maximum stops nothing it has not reached.
+    falling = start.override({"cpg.u_r": 0.6, "cpg.u_a": 0.1})
+    search(GaitSearchSettings(falling, generations=1, offspring=2, sigma=0.3, seed=2, distance_m=0.3,
+                              objective="walk"), tmp_path / "falls", client, progress=False)
+    assert [r["generation"] for r in _read_log(tmp_path / "falls" / "search.jsonl")][:2] == [0, 1]

@@ -599,6 +599,8 @@ class Objective:
     score: Score
     scores_fallers: bool
     about: str
+    # The objective's largest value, where it has one: a search that reaches it stops (no candidate can beat it).
+    maximum: float | None = None
 
 
 def _windows_score(config, base, windows, draws):
@@ -652,14 +654,14 @@ def _of_draws(score_fn):
 # help and the search's records read the names and the texts from here).
 OBJECTIVES: dict[str, Objective] = {
     "windows": Objective(_windows_score, False, 'The largest fractional C_mt saving among the scored windows that also walk (-0.3 if none walks), plus 0.03 for every window that walks.'),
-    "walk": Objective(_walk_score, False, '0 (the search stops improving once a walker is found; use it to find one).'),
+    "walk": Objective(_walk_score, False, '0 (the search stops once a walker is found; use it to find one).', 0.0),
     "policy": Objective(_policy_score, False, "What the paper's learner climbs from its start: the expected reward of the policy N((0.5, 0.5), 0.04 I) over POLICY_DRAWS (or `policy_draws`) fixed draws, relative to no window (a draw with t2 <= t1 is no window and takes its reward), plus half the largest gain of a single drawn window."),
     "expected": Objective(_expected_score, False, "The expected reward's gain alone, over the same draws (one drawn window that saves much cannot carry a gait whose other draws fall)."),
     "nearest": Objective(_nearest_score, False, '-(d / (1 + d) + f) / 3, d the CPG\'s distance from Table III (`distance_from_table_iii`) and f how many of the +-PUSH_FORCE_N pushes (stability\'s, without a window) the gait does not walk through, to find the walker whose CPG is nearest the paper\'s (with the "near_paper" mutations); in (-1, 0], so any walker, however far, beats every fall, and one that survives both pushes beats every one that does not (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push).'),
     "coast": Objective(_coast_score, False, 'The same score over COAST_WINDOWS, the hip off from t1 = 0.2 ... 0.5 s until the swing foot lands (a gait that coasts to touchdown turns the cliff of windows that end late into a plateau).'),
     "floquet": Objective(_of_base(_orbit_score), False, "(1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit (`common.floquet_runs.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map): positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3; FLOQUET_UNDEFINED (-1) when a perturbed step falls."),
     "landscape": Objective(_of_base(_landscape_score), False, "The same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s) through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through."),
-    "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold."),
+    "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold.", 0.0),
     "story": Objective(_of_draws(_story_score), True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
     "hold": Objective(_of_base(_hold_score), True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
     "hold-long": Objective(_of_base(_hold_long_score), True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
@@ -747,9 +749,10 @@ def _score_start(c, settings: GaitSearchSettings, start: EpisodeConfig, windows,
     return value
 
 
-def _generations(settings: GaitSearchSettings, first: int, desc: str, progress: bool):
+def _generations(settings: GaitSearchSettings, first: int, desc: str, progress: bool, best: Callable[[], float]):
     """The generations still to run, counted on a progress bar when asked: yields (generation, note), note(text)
-    showing text beside the bar."""
+    showing text beside the bar; none once the best score `best()` has reached the objective's maximum."""
+    maximum = OBJECTIVES[settings.objective].maximum
     bar = None
     if progress:
         from tqdm import tqdm
@@ -763,6 +766,10 @@ def _generations(settings: GaitSearchSettings, first: int, desc: str, progress: 
 
     try:
         for gen in range(first, settings.generations + 1):
+            if maximum is not None and best() >= maximum:
+                if bar is not None:
+                    bar.set_postfix_str(f"the objective's maximum ({maximum:g}) reached: stopped")
+                return
             yield gen, note
     finally:
         if bar is not None:
@@ -788,7 +795,8 @@ def run(settings: GaitSearchSettings, out: Path, client=None, progress: bool = T
             parent, parent_score, first = last["parent"], last["parent_score"], last["generation"] + 1
         else:
             parent, parent_score, first = start.to_dict(), _score_start(c, settings, start, windows, log), 1
-        for gen, note in _generations(settings, first, "search", progress):
+        for gen, note in _generations(settings, first, "search", progress,
+                                      lambda: parent_score):  # noqa: B023 (the best so far, read each generation)
             jobs = [(parent, seed * 1_000_003 + gen * 101 + k, sigma, windows, settings.mutations,
                      settings.objective, settings.policy_draws) for k in range(settings.offspring)]
             children = map_ordered(c, _child, jobs)
@@ -863,7 +871,8 @@ def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bo
         else:  # generation 0: the start itself, the best so far until a candidate beats it
             best, first = start.to_dict(), 1
             best_score = _score_start(c, settings, start, windows, log, method="cmaes")
-        for gen, note in _generations(settings, first, "cma-es", progress):
+        for gen, note in _generations(settings, first, "cma-es", progress,
+                                      lambda: best_score):  # noqa: B023 (the best so far, read each generation)
             xs = ask(gen)
             configs = [decode(start, mutations, x, settings.sigma).to_dict() for x in xs]
             results = map_ordered(c, _scored, [(cfg, windows, settings.objective, settings.policy_draws)
