@@ -20,6 +20,9 @@ MAX_PERIOD = 8
 # Step periods repeating to within this (s) over the last PERIOD_WINDOW steps: a periodic attractor.
 PERIOD_TOLERANCE_S = 2e-3
 PERIOD_WINDOW = 20
+# The kick (rad/s on the swing hip's rate) that starts the neighbour walk a Lyapunov exponent is read from
+# (`lyapunov_from_neighbours`; the bifurcation command walks it).
+NEIGHBOUR_KICK_RADPS = 0.05
 
 
 def step_period_label(periods_s: Sequence[float], fell: bool = False, window: int = PERIOD_WINDOW,

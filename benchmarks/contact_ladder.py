@@ -17,6 +17,7 @@ import json
 import time
 from pathlib import Path
 
+from drake_biped.analysis import time_step_report
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
 from drake_biped.common.executor import dask_client
 from drake_biped.experiments import time_step
@@ -87,7 +88,7 @@ def markdown(records: list[tuple[str, dict]]) -> str:
                     continue
                 change = f" ({100 * (r['cost_of_transport'] / ref - 1):+.1f} %)" if ref else ""
                 cells.append(f"{r['cost_of_transport']:.4f} ± {r['half_width']:.4f}{change}")
-            lines.append(f"| {name} | {time_step.label(w)} | " + " | ".join(cells) + " |")
+            lines.append(f"| {name} | {time_step_report.label(w)} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 

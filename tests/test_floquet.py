@@ -290,15 +290,15 @@ def test_floquet_command_writes_its_record(tmp_path):
     assert (out / "floquet.png").stat().st_size > 0 and "Spectral radius" in (out / "floquet.md").read_text()
     assert "the phase of the 1 ms control update" in (out / "floquet.md").read_text()  # the default gait's period
     # the stability report's section (`stability --floquet`) carries the same text, headings one level down
+    from drake_biped.analysis.floquet_report import markdown
     from drake_biped.analysis.stability_report import _floquet_sections
-    from drake_biped.common import floquet_runs as floquet
 
-    section = "\n".join(_floquet_sections({"floquet": {"without": {"markdown": floquet.markdown(record)}}}))
+    section = "\n".join(_floquet_sections({"floquet": {"without": {"markdown": markdown(record)}}}))
     assert "#### Floquet multipliers of the periodic orbit (no torque-free period)" in section
     assert f"{record['spectral_radius']:.4f}" in section and "floquet_without/floquet.png" in section
     # the sampling-phase sentence names the record's own control period
     half = {**record, "config": {**record["config"], "sim": {**record["config"]["sim"], "update_period_s": 5e-4}}}
-    assert "the phase of the 0.5 ms control update" in floquet.markdown(half)
+    assert "the phase of the 0.5 ms control update" in markdown(half)
 
 
 @pytest.mark.slow

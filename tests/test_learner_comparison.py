@@ -65,7 +65,7 @@ def test_compare_learners_and_learn_sign_the_same_reduction_the_same_way():
 
     from drake_biped.analysis import rewalks
     from drake_biped.analysis.figures import table_v
-    from drake_biped.experiments.compare_learners import markdown
+    from drake_biped.analysis.learner_comparison import markdown
 
     base, learned = 0.6, 0.6 * (1 - 0.377)
     walk = {"cost_of_transport": learned, "fell": False, "distance_m": 10.0}

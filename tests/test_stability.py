@@ -177,7 +177,9 @@ def test_push_margin_is_the_largest_force_every_phase_survives_however_survival_
     assert m["without"]["backward"]["survived"][-1] == [True] * 4  # survives again above the margin
     assert m["with"]["forward"]["margin_n"] == 30.0 and m["with"]["backward"]["margin_n"] == 40.0
     assert push_margin.margin_of([5.0, 10.0], [[False, True], [True, True]]) == 0.0
-    text = push_margin.markdown(record)
+    from drake_biped.analysis.push_margin_report import markdown
+
+    text = markdown(record)
     assert "the first above the margin: 20 N at phase 2/4" in text
 
 

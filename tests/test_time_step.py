@@ -2,6 +2,7 @@
 
 import pytest
 
+from drake_biped.analysis import time_step_report
 from drake_biped.cli import main
 from drake_biped.experiments.time_step import choose_step
 
@@ -83,7 +84,7 @@ def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
     assert {(c["window"]["start_s"], c["window"]["end_s"]) for c in seen} == {(0.0, 0.0), (0.3, 0.7), (0.5, 1.0)}
     assert rec["walks"] == [None, [0.3, 0.7], [0.5, 1.0]] and rec["chosen_step_s"] == 0.001
     rec.update(gait="Gait coasting_wide", versions={"git_commit": "x", "drake": "y"}, date="d")
-    table = time_step.markdown(rec)
+    table = time_step_report.markdown(rec)
     assert "Gait coasting_wide" in table and "| window 0.5–1 s |" in table and "0.2–0.5" not in table
 
 
@@ -135,7 +136,7 @@ def test_walks_too_short_for_a_long_run_mean_compare_the_whole_walk_and_say_so(m
     monkeypatch.setattr(time_step, "map_ordered", fake_map)
     rec = time_step.study([0.001, 0.002], 0.001, 3.0, None, progress=False, windows=[], measure="episode")
     rec.update(versions={"git_commit": "x", "drake": "y"}, date="d")
-    text = time_step.markdown(rec)
+    text = time_step_report.markdown(rec)
     assert "C_mt is the whole walk's" in text and "the long-run mean after" not in text
     assert "0.6010 (0.0 %)" in text and "0.6020 (+0.2 %)" in text
     assert "Not computed: it needs three finest steps that halve" in text

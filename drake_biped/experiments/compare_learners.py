@@ -17,9 +17,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drake_biped.analysis.cost_of_transport import format_cost
-from drake_biped.analysis.learner_comparison import RUNNING, best_walking_window, compare
-from drake_biped.analysis.series import cmt_change
+from drake_biped.analysis.learner_comparison import (
+    RUNNING,
+    best_walking_window,
+    compare,
+    markdown,
+)
 from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
@@ -138,43 +141,12 @@ def run(settings: CompareSettings, out: Path, client=None, progress: bool = True
     return record
 
 
-def _cell(value, fmt: str) -> str:
-    return "—" if value is None else format(value, fmt)
 
 
-def _rewalked(row: dict[str, Any]) -> str:
-    """The learner's re-walked C_mt change with its spread and the trials holding (`rewalks`)."""
-    if row.get("rewalked_saving") is None:
-        return "—"
-    return (f"{cmt_change(row['rewalked_saving'])} ± {100 * row['rewalked_saving_std']:.1f} % "
-            f"({row['rewalked_holding']}/{row['trials']})")
 
 
-def _wall(row: dict[str, Any]) -> str:
-    if row.get("replayed_from"):
-        return f"replayed from {Path(row['replayed_from']).name}/"  # the folder's name: the record keeps its path
-    return f"{row['wall_s'] / 60:.1f}"
 
 
-def markdown(record: dict[str, Any]) -> str:
-    best = record["best_window"]
-    s = record["settings"]
-    head = ("No window of the map walks" if best is None else
-            f"Best walking window of the map: ({best['t1']:g}, {best['t2']:g}) s, C_mt {format_cost(best['cost_of_transport'])}")
-    lines = [f"{head} (no window {format_cost(record['no_window_cost_of_transport'], '—')}); {s['trials']} trials × "
-             f"{s['episodes']} episodes from ({s['mean'][0]:g}, {s['mean'][1]:g}), variance {s['variance']:g} s².", "",
-             "C_mt change against no window (−: C_mt fell, a saving); a trial holds when it saves ≥ 35 % in "
-             "every re-walk.", "",
-             "| learner | final C_mt | C_mt change | re-walked C_mt change (trials holding) | final means that "
-             "walk | distance to best (s) | trials within 5 % (episode) | falls | wall (min) |",
-             "|---|---:|---:|---:|---:|---:|---|---:|---:|"]
-    for name, r in record["learners"].items():
-        reach = ", ".join("—" if e is None else str(e) for e in r["episodes_to_within"])
-        lines.append(f"| {name} | {format_cost(r['final_cost_of_transport'], '—')} | "
-                     f"{cmt_change(r['reduction'])} | "
-                     f"{_rewalked(r)} | {r['learned_walks']}/{r['trials']} | {_cell(r['mean_distance_to_best_s'], '.3f')} | "
-                     f"{r['reached']}/{r['trials']} ({reach}) | {r['falls']}/{r['episodes']} | {_wall(r)} |")
-    return "\n".join(lines) + "\n"
 
 
 def summary_lines(record: dict[str, Any], out: Path) -> list[str]:

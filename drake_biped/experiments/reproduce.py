@@ -39,6 +39,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from drake_biped.analysis.basins_report import reading as basins_reading
 from drake_biped.analysis.long_run import has_long_run
 from drake_biped.common.options import (
     add_resumable_run_options,
@@ -478,7 +479,7 @@ class Reproduction:
                     "premise": bifurcation.premise(slope["without"]["points"], slope["with"]["points"]),
                     "paper_entrained": [brief(p) for p in paper["points"]],
                     "basins": {"hip_angles_rad": slice_["hip_angles_rad"], "speeds_mps": slice_["speeds_mps"],
-                               **{c: [[basins.reading(cell) for cell in row] for row in g]
+                               **{c: [[basins_reading(cell) for cell in row] for row in g]
                                   for c, g in slice_["grids"].items()}}}
 
         return self.experiment("dynamics", settings, run)

@@ -364,6 +364,7 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
 def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, client) -> dict[str, Any]:
     """The Floquet analysis (common/floquet_runs.py) without and with the window, into floquet_CONDITION/;
     what the report shows of each."""
+    from drake_biped.analysis.floquet_report import markdown
     from drake_biped.common import floquet_runs as floquet
 
     found = {}
@@ -372,7 +373,7 @@ def _floquet(config: EpisodeConfig, window: tuple[float, float], out: Path, clie
         f = floquet.run(floquet.FloquetSettings(gait), out / f"floquet_{condition}", client)
         found[condition] = {k: f[k] for k in ("spectral_radius", "multipliers", "converged_epsilon",
                                               "fixed_point_residual")}
-        found[condition]["markdown"] = floquet.markdown(f)
+        found[condition]["markdown"] = markdown(f)
     return found
 
 
