@@ -258,3 +258,23 @@ def test_a_damaged_trial_record_is_named_with_what_to_do(tmp_path, content, name
     message = str(info.value)
     assert str(path) in message and named in message and "delete it to run trial 0 again" in message
     assert path.read_bytes() == (content if isinstance(content, bytes) else content.encode())  # never overwritten
+
+
+def test_each_learner_records_its_own_settings():
+    garb = make_settings(EpisodeConfig(), 1, 1, seed=0)["learner"]
+    assert set(garb) == {"mean", "variance", "beta", "schedule"}  # GARB's record, as it always was
+    cmaes = make_settings(EpisodeConfig(), 1, 1, seed=0, learner="cmaes")["learner"]
+    assert set(cmaes) == {"mean", "variance", "name", "options"}  # no GARB settings in another learner's
+    with pytest.raises(ParameterError, match="beta and schedule are the settings of GARB's learning rate; "
+                                             "learner 'pgpe' takes none"):
+        make_settings(EpisodeConfig(), 1, 1, seed=0, learner="pgpe", beta=0.5)
+
+
+def test_a_record_that_gave_another_learner_garbs_settings_still_resumes():
+    from drake_biped.common.learning_runs import _fixed
+
+    new = make_settings(EpisodeConfig(), 1, 1, seed=0, learner="cmaes")
+    old = {**new, "learner": {**new["learner"], "beta": 0.8, "schedule": [[None, 0.01]]}}
+    assert _fixed(old) == _fixed(new)
+    garb = make_settings(EpisodeConfig(), 1, 1, seed=0)
+    assert _fixed({**garb, "learner": {**garb["learner"], "beta": 0.5}}) != _fixed(garb)  # GARB's own count

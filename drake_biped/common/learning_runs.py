@@ -75,8 +75,10 @@ def _fixed(settings: dict[str, Any]) -> dict[str, Any]:
     episodes (a run may be extended; the schedule depends on the episode number only). Records that name no
     learner are GARB's."""
     fixed = {k: v for k, v in settings.items() if k not in ("trials", "episodes")}
-    if "learner" in fixed and "name" not in fixed["learner"]:
-        fixed["learner"] = {"name": DEFAULT_LEARNER, "options": {}, **fixed["learner"]}
+    if "learner" in fixed:
+        ls = {"name": DEFAULT_LEARNER, "options": {}, **fixed["learner"]}
+        own = ("name", "mean", "variance", "options", "start_state", *learner_class(ls["name"]).SETTINGS)
+        fixed["learner"] = {k: v for k, v in ls.items() if k in own}  # (records once gave every learner GARB's)
     return fixed
 
 
@@ -192,9 +194,18 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
     check_learning_size(f"--trials {trials} x --episodes {episodes}", trials * episodes, force)
     if not isinstance(seed, int) or seed < 0:
         raise ParameterError(f"--seed {seed!r}: must be an integer >= 0")
-    GarbLearner(mean, variance, beta, schedule)  # validates what every record holds (beta and schedule: GARB's)
-    learner_settings = {"mean": list(map(float, mean)), "variance": float(variance), "beta": float(beta),
-                        "schedule": [list(b) for b in schedule]}
+    try:
+        cls = learner_class(learner)
+    except ParameterError as exc:
+        raise ParameterError(f"--learner {learner!r}: {exc}") from None
+    own = {"beta": float(beta), "schedule": [list(b) for b in schedule]}  # GARB's settings
+    if "beta" in cls.SETTINGS:
+        GarbLearner(mean, variance, beta, schedule)  # validates them
+    elif own != {"beta": GARB_BETA, "schedule": [list(b) for b in TABLE_II]}:
+        raise ParameterError(f"beta and schedule are the settings of GARB's learning rate; learner {learner!r} "
+                             "takes none (its own are its options)")
+    learner_settings = {"mean": list(map(float, mean)), "variance": float(variance),
+                        **{k: own[k] for k in cls.SETTINGS}}
     if learner != DEFAULT_LEARNER or options:  # a record names its learner unless it is the default's
         learner_settings.update(name=learner, options=dict(options or {}))
         try:
@@ -397,7 +408,8 @@ def learning_record(settings: dict[str, Any], trials: list[Trial], evaluation: d
 class LearningSettings:
     """A learning run: `trials` independent learners (`learner`, GARB by default, with `options`) of
     `episodes` episodes each on `config`'s gait, the policy starting at `mean` with `variance` per time
-    (the paper's settings by default). beta and schedule are GARB's."""
+    (the paper's settings by default). beta and schedule are GARB's settings (Learner.SETTINGS): another learner
+    refuses them and takes `options`."""
 
     config: EpisodeConfig = field(default_factory=EpisodeConfig)
     trials: int = LEARNING_TRIALS

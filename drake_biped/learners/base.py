@@ -22,6 +22,9 @@ class Learner(abc.ABC):
     """
 
     name: ClassVar[str]
+    # A learning run's settings of this learner beyond the mean, the variance and its `options`, recorded with
+    # the run (GARB: its beta and Table II's schedule); none for most learners.
+    SETTINGS: ClassVar[tuple[str, ...]] = ()
     mean: np.ndarray
 
     @abc.abstractmethod

@@ -62,6 +62,7 @@ class GarbLearner(Learner):
     """Gaussian policy over (t1, t2), updated once per episode (see the module docstring)."""
 
     name = "garb"
+    SETTINGS = ("beta", "schedule")
 
     def __init__(
         self,
