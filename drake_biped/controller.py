@@ -289,15 +289,48 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     return v
 
 
+def _section_markdown(cls: type) -> str:
+    """One section of EpisodeConfig as a Markdown table, from its fields' declarations (`param`)."""
+    import dataclasses
+
+    def bounds(b) -> str:
+        if b is None or b == (None, None):
+            return ""
+        return f"[{'-inf' if b[0] is None else f'{b[0]:g}'}, {'inf' if b[1] is None else f'{b[1]:g}'}]"
+
+    rows = ["| field | default | unit | bounds | meaning |", "|---|---|---|---|---|"]
+    for f in dataclasses.fields(cls):
+        if "doc" in f.metadata:
+            default = f.default if not isinstance(f.default, float) else f"{f.default:g}"
+            rows.append(f"| `{f.name}` | {default!s} | {f.metadata['unit'] or '-'} | {bounds(f.metadata['bounds'])} "
+                        f"| {f.metadata['doc'].replace('|', '/')} |")
+    return "\n".join(rows) + "\n"
+
+
 def parameter_markdown() -> str:
-    """docs/PARAMETERS.md: the controller's Context parameter (LAW), slot by slot, from its declarations."""
-    return ("# The controller's parameters\n\n"
-            "Generated from the code (`make docs-tables`; tests/test_parameters.py checks it is current). The "
-            "controller's numbers for one episode are one numeric parameter of its Drake Context, `LAW` in "
+    """docs/PARAMETERS.md: the controller's Context parameter (LAW), slot by slot, and every section of an
+    episode's configuration, field by field, from their declarations."""
+    from drake_biped.params import ContactParams, EpisodeConfig, InitialConditions, Push
+
+    sections = {"cpg": CpgParams, "gait": GaitParams, "initial": InitialConditions, "window": TorqueFreeWindow,
+                "ground": Ground, "push": Push, "sim": SimulationParams, "contact": ContactParams,
+                "(top level)": EpisodeConfig}
+    configuration = "".join(f"\n### `{name}`: {cls.__name__}\n\n" + _section_markdown(cls)
+                            for name, cls in sections.items())
+    return ("# Parameters\n\n"
+            "Generated from the code (`make docs-tables`; tests/test_parameters.py checks it is current).\n\n"
+            "## The controller's Context parameter\n\n"
+            "The controller's numbers for one episode are one numeric parameter of its Drake Context, `LAW` in "
             "drake_biped/controller.py: the slots that copy a field of the episode's configuration take its "
             "declaration in drake_biped/params.py (`param`: default, unit, bounds, meaning); the others are "
             "computed from it. Unit `1`: dimensionless (a gain ratio, a flag 1 or 0, a count of steps).\n\n"
-            + LAW.markdown())
+            + LAW.markdown()
+            + "\n## The episode's configuration\n\n"
+            "Every field of `EpisodeConfig`'s sections, as a params file or `config.override({\"section.field\": "
+            "value})` names it, with the dataclass's default (`CpgParams()`; `EpisodeConfig()` takes the default gait's "
+            "CPG and gait sections, drake_biped/gaits/default.json, and a shipped gait file its own), unit, bounds "
+            "(the dataclass refuses a value outside them) and meaning. Unit `-`: a choice among named readings.\n"
+            + configuration)
 
 
 # The kernel's return code: bits for what the Python side must do after it.

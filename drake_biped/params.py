@@ -348,11 +348,9 @@ class TorqueFreeWindow(_Validated):
 class Push(_Validated):
     """A horizontal force on the torso (N, + forward) from start_s for duration_s."""
 
-    force_n: float = 0.0
-    start_s: float = 0.4
-    duration_s: float = 0.1
-
-    _RANGES = {"force_n": (-1000.0, 1000.0), "start_s": (0.0, None), "duration_s": (0.0, 10.0)}
+    force_n: float = param(0.0, "N", "the push's horizontal force on the torso (+ forward)", -1000.0, 1000.0)
+    start_s: float = param(0.4, "s", "when the push starts (episode time)", 0.0, None)
+    duration_s: float = param(0.1, "s", "how long it lasts", 0.0, 10.0)
 
 
 @dataclass(frozen=True)
@@ -473,13 +471,15 @@ class ContactParams(_Validated):
     the step is halved and long walks do not converge (docs/RESULTS.md, "Physics with a continuous limit"). A field left None takes
     Drake's default."""
 
-    stiffness_npm: float | None = 1e6
-    relaxation_time_s: float | None = 0.1
-    hunt_crossley_dissipation_spm: float | None = 50.0
-    sap_near_rigid_threshold: float = 0.0
-
-    _RANGES = {"stiffness_npm": (1e2, 1e9), "relaxation_time_s": (0.0, 10.0),
-               "hunt_crossley_dissipation_spm": (0.0, 1e3), "sap_near_rigid_threshold": (0.0, 10.0)}
+    stiffness_npm: float | None = param(1e6, "N/m", "point-contact stiffness of each foot sphere and the ground "
+                                        "(None: Drake's default)", 1e2, 1e9)
+    relaxation_time_s: float | None = param(0.1, "s", "SAP's linear dissipation, as a relaxation time (None: Drake's "
+                                            "default)", 0.0, 10.0)
+    hunt_crossley_dissipation_spm: float | None = param(
+        50.0, "s/m", "Hunt & Crossley dissipation, used by the \"similar\", \"lagged\" and \"tamsi\" approximations "
+        "(None: Drake's default)", 0.0, 1e3)
+    sap_near_rigid_threshold: float = param(0.0, "1", "SAP's near-rigid threshold (0: the regime off; Drake's "
+                                            "default 1)", 0.0, 10.0)
 
 
 # What a record written before the contact was made explicit ran on: Drake's defaults for every material
@@ -603,7 +603,7 @@ class EpisodeConfig(_Validated):
     push: Push | None = None
     sim: SimulationParams = field(default_factory=SimulationParams)
     contact: ContactParams = field(default_factory=ContactParams)
-    seed: int = 0
+    seed: int = param(0, "1", "recorded with the result (the episode itself is deterministic)")
     # The robot: None for the shipped model (models/biped.urdf, Table I), else a user's model file.
     model: RobotModel | None = None
 

@@ -65,3 +65,14 @@ def test_the_entrained_reading_drops_the_phase_condition():
 def test_docs_table_is_current():
     path = Path(__file__).resolve().parents[1] / "docs" / "PARAMETERS.md"
     assert path.read_text() == ctl.parameter_markdown(), "run `make docs-tables`"
+
+
+def test_every_configuration_field_is_declared_once_with_its_meaning():
+    from drake_biped.params import ContactParams, InitialConditions, Push
+
+    for cls in (type(EpisodeConfig().cpg), type(EpisodeConfig().gait), InitialConditions, type(EpisodeConfig().window),
+                type(EpisodeConfig().ground), Push, type(EpisodeConfig().sim), ContactParams):
+        for f in fields(cls):
+            info = parameter_info(cls, f.name)  # KeyError for a field not declared with param()
+            assert info["doc"] and (info["unit"] or f.type in ("str", str)), f"{cls.__name__}.{f.name}"
+            assert not getattr(cls, "_RANGES", {}), f"{cls.__name__} declares bounds twice"
