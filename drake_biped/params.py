@@ -226,15 +226,15 @@ class GaitParams(_Validated):
     torque is exactly zero under every drive.
     """
 
-    swing_reading: str = param("anchored", "", 'how zeta drives the swing (above): "anchored" or "integrated"')
-    phase_reading: str = param("reset", "", 'what a touchdown does to the CPG (above): "reset" or "entrained"')
+    swing_reading: str = param("anchored", "", 'how zeta drives the swing (see GaitParams): "anchored" or "integrated"')
+    phase_reading: str = param("reset", "", 'what a touchdown does to the CPG (see GaitParams): "reset" or "entrained"')
     swap_timing: str = param(
         "predicted", "", 'when the roles\' torques swap at a touchdown: "predicted", at the instant inside the '
         "control period where the swing foot's clearance, extrapolated over the period, crosses the touchdown "
         "height (the period's torques blend the two roles' by the part of it each holds); \"update\", from the "
         "update that detects the crossing (up to one period late)")
-    hip_drive: str = param("servo", "", 'what realizes zeta at the hip (above): "servo" or "motor"')
-    hip_joint: str = param("swing", "", 'the motor\'s joint (above): "swing" or "inter_leg"')
+    hip_drive: str = param("servo", "", 'what realizes zeta at the hip (see GaitParams): "servo" or "motor"')
+    hip_joint: str = param("swing", "", 'the motor\'s joint (see GaitParams): "swing" or "inter_leg"')
     motor_limit_nm: float = param(40.0, "N*m", "the hip motor's maximum torque (hip_drive \"motor\")", 0.0, 200.0)
     swing_offset_rad: float = param(
         0.0, "rad", "integrated reading: a constant offset of the swing reference at the end of the half-cycle",
@@ -412,7 +412,7 @@ class SimulationParams(_Validated):
     fall_pitch_rad: float = param(1.0, "rad", "a fall: the torso's pitch beyond this", 0.05, math.pi)
     # SAP was chosen by measurement (benchmarks/bench.py): "similar" and "lagged" walk but are no faster, and
     # the gait falls within half a metre under "tamsi".
-    contact_approximation: str = param("sap", "", "Drake's discrete contact approximation")
+    contact_approximation: str = param("sap", "", "Drake's discrete contact approximation: \"sap\", \"similar\", \"lagged\" or \"tamsi\"")
 
     CONTACT_APPROXIMATIONS = ("sap", "similar", "lagged", "tamsi")
     # The two readings of the controller's clock, as records name them.
