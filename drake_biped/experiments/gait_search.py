@@ -971,5 +971,10 @@ def command(args: argparse.Namespace) -> int:
     search = run_cmaes if args.method == "cmaes" else run
     with cluster(args) as client:
         result = search(settings, Path(args.out), client)
-    print(f"best score {result['score']:+.3f}; parameters in {args.out}/best_config.json (use --params)")
+    maximum = OBJECTIVES[settings.objective].maximum
+    reached = ""
+    if maximum is not None and result["score"] >= maximum:
+        first = next(r["generation"] for r in _read_log(Path(args.out) / "search.jsonl") if r["parent_score"] >= maximum)
+        reached = f" (the objective's maximum, reached in generation {first}: the search stops there)"
+    print(f"best score {result['score']:+.3f}{reached}; parameters in {args.out}/best_config.json (use --params)")
     return 0
