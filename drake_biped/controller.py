@@ -291,7 +291,7 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
 
 def _section_markdown(cls: type) -> str:
     """One section of EpisodeConfig as a Markdown table, from its fields' declarations (`param`)."""
-    import dataclasses
+    from dataclasses import fields
 
     def bounds(b) -> str:
         if b is None or b == (None, None):
@@ -299,7 +299,7 @@ def _section_markdown(cls: type) -> str:
         return f"[{'-inf' if b[0] is None else f'{b[0]:g}'}, {'inf' if b[1] is None else f'{b[1]:g}'}]"
 
     rows = ["| field | default | unit | bounds | meaning |", "|---|---|---|---|---|"]
-    for f in dataclasses.fields(cls):
+    for f in fields(cls):
         if "doc" in f.metadata:
             default = f.default if not isinstance(f.default, float) else f"{f.default:g}"
             rows.append(f"| `{f.name}` | {default!s} | {f.metadata['unit'] or '-'} | {bounds(f.metadata['bounds'])} "

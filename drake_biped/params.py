@@ -81,10 +81,7 @@ def parameter_info(cls: type, name: str) -> dict[str, Any]:
 
 class _Validated:
     """Mixin: every field is checked against its declared type after init (an int given for a float is
-    stored as a float), and every number against its declared bounds (`param`; `_RANGES`, name -> (lo, hi),
-    for the sections that declare none) or for being finite."""
-
-    _RANGES: dict[str, tuple[float | None, float | None]] = {}
+    stored as a float), and every number against its declared bounds (`param`) or for being finite."""
 
     def __post_init__(self) -> None:
         owner = type(self).__name__
@@ -111,7 +108,7 @@ class _Validated:
                         else "")
                 raise ParameterError(f"{owner}.{f.name} must be a {kind}, got {type(value).__name__} "
                                      f"{value!r}{hint}")
-            bounds = f.metadata.get("bounds") or self._RANGES.get(f.name)
+            bounds = f.metadata.get("bounds")
             if bounds is not None and _is_number(value):
                 _check_range(owner, f.name, value, *bounds)
             elif isinstance(value, float):
