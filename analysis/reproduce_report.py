@@ -304,12 +304,17 @@ def dynamics_section(out: Path, d: dict[str, Any], wtext: str) -> list[str]:
     ]
 
 
-def walk_section(walk: dict[str, Any]) -> list[str]:
-    """The report's section on the default gait's walk (`walk/`), from its summary."""
+def gait_label(gait: str) -> str:
+    """How the report names the gait a run walks: "the default gait", "the `paper` gait"."""
+    return "the default gait" if gait == "default" else f"the `{gait}` gait"
+
+
+def walk_section(walk: dict[str, Any], gait: str = "default") -> list[str]:
+    """The report's section on the gait's walk (`walk/`), from its summary."""
     return [
         "## The walk (`walk/`)",
         "",
-        f"The default gait from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
+        f"{gait_label(gait)[0].upper()}{gait_label(gait)[1:]} from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
         f"{format_cost(walk['cost_of_transport'], '—')}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
         f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
         "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
@@ -319,7 +324,9 @@ def walk_section(walk: dict[str, Any]) -> list[str]:
     ]
 
 
-def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any]) -> tuple[str, list]:
+def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any],
+                    gait: str = "default", choices: str = "") -> tuple[str, list]:
+    label = gait_label(gait)
     window = tuple(s["push_margin"]["settings"]["window"])  # the learned window (Reproduction.learned_window)
     source = s["push_margin"]["window_source"]
     wtext = _window_text(window)
@@ -329,8 +336,9 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     walk = s["walk"]
     grid = s["grid"]
     t3 = grid["table_iii"]
-    verdicts.append(("Table III walks", "walks (the grid's best)",
-                     f"falls after {_steps(t3['steps'])}, {t3['distance_m']:.2f} m", NOT_REPRODUCED))
+    verdicts.append((f"Table III walks ({label}'s other gains)", "walks (the grid's best)",
+                     ("walks" if not t3["fell"] else f"falls after {_steps(t3['steps'])}")
+                     + f", {t3['distance_m']:.2f} m", REPRODUCED if not t3["fell"] else NOT_REPRODUCED))
     pg = s["paper_gait"]
     verdicts.append(("Table III walks, ζ driving the swing as printed (unprinted gains searched)", "walks",
                      ("walks" if not pg["fell"] else f"falls after {_steps(pg['steps'])}") + f", {pg['distance_m']:.2f} m",
@@ -361,7 +369,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     if "dynamics" in s:
         verdicts += dynamics_rows(s["dynamics"], wtext)
     on_2deg = ("with the grid's best" if climbs_2deg(s["grid_slope2deg"])
-               else "on the default gait (no grid point climbs)")
+               else f"on {label} (no grid point climbs)")
     for name, label in (("slope", "Slope story, 0.02 rad (Figs. 8–9)"),
                         ("slope2deg", f"Slope story, 2.0° {on_2deg} (Figs. 10–11)")):
         ours, verdict = slope_verdict(s[name])
@@ -384,9 +392,11 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"folder took {wall / 60:.1f} min (work found already done in the folder, such as learning episodes "
         f"resumed, is not counted). drake-biped {code.get('drake_biped')} ({code.get('git_commit')}), Drake "
         f"{code.get('drake')}. Paper: Takita, Azuma & Shibata, *Acquisition of Energy-Efficient Bipedal Walking "
-        "Using CPG-Based Reinforcement Learning*. Every claim is measured on one gait, the default (its "
+        "Using CPG-Based Reinforcement Learning*. Every claim is measured on one gait, "
+        + ("the default" if gait == "default" else f"`{gait}`") + " (its "
         f"plant step {_ms(s['learn']['settings']['config'])}), with one learned window: {wtext}, {source}. Each row "
-        "links to its section; every number below is measured by this run, in the folder named in its section.",
+        "links to its section; every number below is measured by this run, in the folder named in its section."
+        + (f" What this gait's story chooses where the paper prints nothing: {choices}." if choices else ""),
         "",
         "| what | paper | ours | verdict |",
         "|---|---|---|---|",
@@ -396,14 +406,15 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         "![verdicts](report_summary.png)",
         "",
-        *walk_section(walk),
+        *walk_section(walk, gait),
         "## Grid search, Table IV (`grid/`)",
         "",
         f"{grid['points']} points over Table IV's CPG ranges and the initiation, level ground, one episode each: "
         f"{grid['walked']} walk {profile.distance_m:g} m; the furthest, {best['distance_m']:.2f} m, at "
         + ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in best["point"].items())
-        + f". Table III itself (with the default gait's other gains) falls after {_steps(t3['steps'])} "
-        f"({t3['distance_m']:.2f} m). The default gait's CPG: "
+        + f". Table III itself (with {label}'s other gains) "
+        + ("walks" if not t3["fell"] else f"falls after {_steps(t3['steps'])}")
+        + f" ({t3['distance_m']:.2f} m). {label[0].upper()}{label[1:]}'s CPG: "
         + ", ".join(f"{k} {v:.4g}" for k, v in s["learn"]["settings"]["config"]["cpg"].items()) + ".",
         "",
         "![grid](grid/grid_slices.png)",
@@ -422,7 +433,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     wm = s["window_map"]
     wbest = wm["best"]
     lines += [
-        "## Torque-free windows of the default gait (`window_map/`)",
+        f"## Torque-free windows of {label} (`window_map/`)",
         "",
         f"{wm['walked']} of {wm['windows']} windows walk {profile.distance_m:g} m; no window C_mt "
         f"{format_cost(wm['no_window_cost_of_transport'], '—')}"
@@ -484,7 +495,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     lines += [
         "## Slopes (Figs. 8–11, Table VII)",
         "",
-        "The default gait on 2 m level, then the slope, 10 m in all. The learner starts from the learned window "
+        f"{label[0].upper()}{label[1:]} on 2 m level, then the slope, 10 m in all. The learner starts from the "
+        "learned window "
         f"({wtext}; from its learning record's policy when a trial learned it, else with σ² 0.04).",
         "",
     ]
@@ -494,11 +506,11 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                 f"### Table VII: CPG parameters for 2.0° (`grid_slope2deg/`, {g2['points']} points, {g2['walked']} "
                 "climb)",
                 "",
-                f"Verdict: **{vii_verdict}**. Ours: the default gait with its torso leaned further forward, a larger "
+                f"Verdict: **{vii_verdict}**. Ours: {label} with its torso leaned further forward, a larger "
                 "placement gain and u_a, u_r, κ raised as Table VII raises them; the 2.0° story runs on the grid's "
-                "best (the default gait itself when no point climbs).",
+                f"best ({label} itself when no point climbs).",
                 "",
-                "| parameter | paper: Table III → Table VII | ours: default → "
+                f"| parameter | paper: Table III → Table VII | ours: {'default' if gait == 'default' else gait} → "
                 + ("2.0° best |" if climbs_2deg(g2) else "the furthest fall (nothing climbs) |"),
                 "|---|---|---|",
                 *vii_rows,
@@ -508,7 +520,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         lines += [
             f"### The slope story, {figs} (`{name}/`)",
             "",
-            f"Verdict: **{slope_verdict(s[name])[1]}**. The gait: the default"
+            f"Verdict: **{slope_verdict(s[name])[1]}**. The gait: {label}"
             + ("" if not point else " with " + ", ".join(f"{k.split('.')[-1]} {v:.4g}" for k, v in point.items()))
             + ".",
             "",
@@ -528,7 +540,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         embed(_read(out, "time_step/time_step_study.md"), "time_step"),
         "![time step](time_step/time_step_study.png)",
         "",
-        *other_gaits_section(),
+        *other_gaits_section(gait),
         "Rerun the same command to reuse every finished experiment; `drake-biped reproduce --out DIR` (without "
         "`--quick`) is the full run.",
         "",
@@ -536,16 +548,16 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     return "\n".join(lines), verdicts
 
 
-def other_gaits_section() -> list[str]:
-    """The report's closing section: the shipped gaits other than the default, and why each exists."""
+def other_gaits_section(gait: str = "default") -> list[str]:
+    """The report's closing section: the shipped gaits other than the run's, and why each exists."""
     from drake_biped.resources import gait_about, gait_names
 
     lines = ["## Other gaits, and why each exists", "",
-             "Every claim above is measured on the default gait. The other shipped gaits (`--params NAME`) each "
+             f"Every claim above is measured on {gait_label(gait)}. The other shipped gaits (`--params NAME`) each "
              "told part of the story before it; their records are in docs/HISTORY.md. Each one's reasons are its "
              "file's `about` (drake_biped/gaits/).", "",
              "| gait | why it exists |", "|---|---|"]
-    lines += [f"| `{name}` | {gait_about(name)} |" for name in gait_names() if name != "default"]
+    lines += [f"| `{name}` | {gait_about(name)} |" for name in gait_names() if name != gait]
     return lines + [""]
 
 
@@ -643,14 +655,16 @@ def full_run_digest(out: Path, verdicts: list[tuple[str, str, str, str]], profil
 
 
 def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Any,
-                 code: dict[str, Any], full_run: dict[str, Any] | None = None) -> list[Path]:
-    """report.md, report.html and report_summary.png; a full run also writes verdicts.json (full_run_digest),
-    which a quick run checks; a quick run's report is quick_report_markdown's, beside `full_run`."""
+                 code: dict[str, Any], full_run: dict[str, Any] | None = None, gait: str = "default",
+                 choices: str = "") -> list[Path]:
+    """report.md, report.html and report_summary.png of a run on `gait` (`choices`: what its story chooses
+    where the paper prints nothing); a full run also writes verdicts.json (full_run_digest), which a quick run
+    checks; a quick run's report is quick_report_markdown's, beside `full_run`."""
     paths = [out / "report.md", out / "report.html"]
     if profile.name == "quick":
-        text = quick_report_markdown(out, summaries, profile, code, full_run)
+        text = quick_report_markdown(out, summaries, profile, code, full_run, gait)
     else:
-        text, verdicts = report_markdown(out, summaries, profile, code)
+        text, verdicts = report_markdown(out, summaries, profile, code, gait, choices)
         paths.append(out / "verdicts.json")
         write_text_atomic(paths[-1], json.dumps(full_run_digest(out, verdicts, profile, code), indent=1) + "\n")
     write_text_atomic(paths[0], text)
@@ -701,11 +715,10 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
     return rows
 
 
-def full_run_gait(full_run: dict[str, Any] | None) -> str | None:
-    """The gait the shipped full run was measured on, when it is not today's default: the shipped gait's name
-    (`--params NAME`) whose CPG, gains and initiation its checks walked, else "another gait"; None when it is
-    the default gait (or the full run records no checks)."""
-    from drake_biped.params import EpisodeConfig
+def full_run_gait_name(full_run: dict[str, Any] | None) -> str | None:
+    """The shipped gait (`--params NAME`) whose CPG, gains and initiation the full run's checks walked:
+    "default", another shipped gait's name, or None (another gait, or no checks recorded)."""
+    from drake_biped.params import config_of_record
     from drake_biped.resources import gait_names, load_gait
 
     configs = [c["config"] for c in (full_run or {}).get("checks", {}).values() if "config" in c]
@@ -713,19 +726,30 @@ def full_run_gait(full_run: dict[str, Any] | None) -> str | None:
         return None
     sections = ("cpg", "gait", "initial")
     same = lambda a, b: all(a.get(k) == b.get(k) for k in sections)  # noqa: E731
-    if same(configs[0], EpisodeConfig().to_dict()):
+    recorded = config_of_record(configs[0]).to_dict()  # a record older than a field reads its default
+    for name in sorted(gait_names(), key=lambda n: n != "default"):
+        if same(recorded, load_gait(name).to_dict()):
+            return name
+    return None
+
+
+def full_run_gait(full_run: dict[str, Any] | None, gait: str = "default") -> str | None:
+    """The gait the shipped full run was measured on, when it is not `gait` (the one this run walks): the
+    shipped gait's name, quoted, else "another gait"; None when it is `gait` (or the full run records no
+    checks)."""
+    if not (full_run or {}).get("checks"):
         return None
-    for name in (n for n in gait_names() if n != "default"):
-        if same(configs[0], load_gait(name).to_dict()):
-            return f"`{name}`"
-    return "another gait"
+    name = full_run_gait_name(full_run)
+    if name == gait:
+        return None
+    return "another gait" if name is None else f"`{name}`"
 
 
 def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any],
-                          full_run: dict[str, Any] | None) -> str:
+                          full_run: dict[str, Any] | None, gait: str = "default") -> str:
     rows = quick_rows(s, full_run)
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
-    other = full_run_gait(full_run)
+    other = full_run_gait(full_run, gait)
     quick_summary_figure(rows, out / "report_summary.png", other)
     walk, fr = s["walk"], s.get("full_run") or {}
     full_code = (full_run or {}).get("code", {})
@@ -742,8 +766,9 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         "",
     ]
     if other is not None:
-        lines += [f"The shipped full run was measured on {other}, not on the default gait this run walks: its "
-                  "column is that gait's (its windows were walked again on it).", ""]
+        lines += [f"The shipped full run was measured on {other}, not on {gait_label(gait)} this run walks: its "
+                  "column is that gait's" + (" (its windows were walked again on it)." if s.get("full_run") else
+                                             "; its windows are walked again only by a quick run on its gait."), ""]
     lines += [
         "| what | paper | this run (quick) | full run (checked here) |",
         "|---|---|---|---|",
@@ -755,12 +780,11 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         "",
         "![verdicts](report_summary.png)",
         "",
-        *walk_section(walk),
-        "## The full run's learned windows, walked again here (`full_run/`)",
-        "",
-        "| learning run | window (s) | C_mt recorded | C_mt here | same |",
-        "|---|---|---|---|---|",
+        *walk_section(walk, gait),
     ]
+    if fr:
+        lines += ["## The full run's learned windows, walked again here (`full_run/`)", "",
+                  "| learning run | window (s) | C_mt recorded | C_mt here | same |", "|---|---|---|---|---|"]
     for check in fr.get("checks", {}).values():
         for w in check["rows"]:
             window = "none" if w["t2"] <= max(0.0, w["t1"]) else f"{max(0.0, w['t1']):.3f}–{w['t2']:.3f}"

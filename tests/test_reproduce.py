@@ -238,6 +238,47 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
     assert full_run_gait(digest(load_gait("steady"))) == "`steady`"
     assert full_run_gait(digest(EpisodeConfig().override({"u_a": 2.0}))) == "another gait"
     assert full_run_gait({"checks": {}}) is None and full_run_gait(None) is None
+    # a run on another gait names the default gait's full run, and nothing when the full run is its own
+    assert full_run_gait(digest(EpisodeConfig()), "paper") == "`default`"
+    assert full_run_gait(digest(load_gait("paper")), "paper") is None
+    # a record older than a field (the shipped full run's, before the hip motor's) is read with its default
+    from drake_biped.resources import full_run_digest
+
+    assert full_run_gait(full_run_digest()) is None
+
+
+def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
+    """`--gait paper`: every step's walker is the shipped `paper` gait (its own plant step), its matched
+    exploration and its t1 sweep are its story's, the shipped full run (the default gait's) is not checked on
+    it, and a folder of one gait's run refuses another's."""
+    import dataclasses
+
+    from drake_biped.experiments.reproduce import STORIES, ReproduceSettings, story_of
+    from drake_biped.params import EpisodeConfig
+    from drake_biped.resources import load_gait
+
+    paper = Reproduction(tmp_path, QUICK, None, gait="paper")
+    shipped = load_gait("paper")
+    assert paper.base == shipped and paper.level.cpg == shipped.cpg and paper.level.gait == shipped.gait
+    assert paper.level.sim == dataclasses.replace(shipped.sim, distance_m=QUICK.distance_m)
+    assert Reproduction(tmp_path, QUICK, None).base == EpisodeConfig()
+    # the default story's sweep is fixed; the paper's follows the learned window, ending before its t2
+    assert STORIES["default"].t1_values((0.37, 0.86), 9)[::8] == (0.30, 0.46)
+    values = STORIES["paper"].t1_values((0.1, 0.2), 5)
+    assert values[0] == 0.02 and values[-1] == 0.18 and len(set(values)) == 5
+    assert STORIES["paper"].t1_values((0.02, 0.3), 3)[0] == 0.0
+    assert "full_run" in steps_of(QUICK) and "full_run" not in steps_of(QUICK, "paper")
+    with pytest.raises(ParameterError, match="--gait 'slow'"):
+        story_of("slow")
+    with pytest.raises(ParameterError, match="--gait 'slow'"):
+        ReproduceSettings(QUICK, "slow")
+    check_out(tmp_path, QUICK, "paper")
+    check_out(tmp_path, QUICK, "paper")
+    with pytest.raises(ParameterError, match="holds a run on the 'paper' gait"):
+        check_out(tmp_path, QUICK)
+    check_out(tmp_path / "d", QUICK)
+    with pytest.raises(ParameterError, match="holds a run on the 'default' gait"):
+        check_out(tmp_path / "d", QUICK, "paper")
 
 
 @pytest.mark.slow
@@ -317,3 +358,5 @@ def test_the_2deg_grid_raises_the_default_gaits_cpg_as_table_vii_does():
         g.torso_pitch_rad  # leaning further forward only
     quick = {a.name: a.values for a in Reproduction(Path("."), SMOKE, None).slope_axes()}
     assert set(quick) == {"gait.torso_pitch_rad", "cpg.u_a"} and all(len(v) == 2 for v in quick.values())
+    paper = {a.name: a.values for a in Reproduction(Path("."), FULL, None, gait="paper").slope_axes()}
+    assert paper["cpg.u_a"] == (2.0, 2.5) and paper["cpg.u_r"] == (2.1, 2.625) and paper["cpg.kappa"] == (1.8, 2.25)

@@ -18,9 +18,10 @@ functions as its own command:
                      grid's best
     compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
 
-All of it on one gait, the default: "the learned window" is the best trial of `learn` (of `learn_variant`
-when the paper's settings learned none; the window map's cheapest when neither did). The other shipped gaits
-are named in the report's closing section, with why each exists. Then DIR/report.md and DIR/report.html:
+All of it on one gait, the default or `--gait paper` (STORIES: the choices each gait's story makes beyond
+the paper's printed settings): "the learned window" is the best trial of `learn` (of `learn_variant` when the
+paper's settings learned none; the window map's cheapest when neither did). The other shipped gaits are named
+in the report's closing section, with why each exists. Then DIR/report.md and DIR/report.html:
 every table and figure with the paper's value beside ours and a verdict for each. `--quick` runs every experiment on small settings (minutes on 2 cores); the full run takes
 hours and says so up front.
 
@@ -61,7 +62,8 @@ from drake_biped.records import read_json, read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-__all__ = ["FULL", "QUICK", "Profile", "ReproduceSettings", "Reproduction", "check_out", "run", "steps_of"]
+__all__ = ["FULL", "QUICK", "STORIES", "Profile", "ReproduceSettings", "Reproduction", "Story", "check_out", "run",
+           "steps_of", "story_of"]
 
 LEVEL_WINDOW = LEARNED_WINDOW_S  # compared with none where no window was learned and none of the map walks
 SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
@@ -70,6 +72,53 @@ SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record
 SLOPE_2DEG_CPG_SCALE = 1.25
 SLOPE_2DEG_LEANS = (0.0, 0.04, 0.08, 0.12)
 SLOPE_2DEG_PLACEMENT = 0.1
+T1_SWEEP_HALF_SPAN_S = 0.08  # a story's bifurcation over t1 spans the learned t1 +- this, where it names no span
+
+
+@dataclass(frozen=True)
+class Story:
+    """What a reproduction chooses on one shipped gait where the paper prints nothing: the gait (a shipped
+    gait's name), the start (t1, t2 in s) and variance of the exploration matched to it (`learn_variant`), and
+    the span of t1 (s) its dynamics step sweeps, the learned t2 kept (None: the learned t1 +-
+    T1_SWEEP_HALF_SPAN_S, ending before t2). `why`: the reasons, for the report; `cost`: the wall time of its
+    episodes against the default gait's, for the time a run announces."""
+
+    gait: str
+    variant_start: tuple[float, float]
+    variant_variance: float
+    t1_sweep: tuple[float, float] | None = None
+    why: str = ""
+    cost: float = 1.0
+
+    def t1_values(self, window: tuple[float, float], num: int) -> tuple[float, ...]:
+        """The values of t1 the dynamics step sweeps around the learned `window`."""
+        import numpy as np
+
+        if self.t1_sweep is not None:
+            lo, hi = self.t1_sweep
+        else:
+            t1, t2 = window
+            lo, hi = max(0.0, t1 - T1_SWEEP_HALF_SPAN_S), min(t1 + T1_SWEEP_HALF_SPAN_S, t2 - 0.02)
+        return tuple(float(v) for v in np.round(np.linspace(lo, hi, num), 4))
+
+
+STORIES = {
+    "default": Story("default", (0.4, 0.4), 0.01, (0.30, 0.46),
+                     why="the default gait (0.42 s steps): the variant starts where its windows begin (0.4, 0.4 s) "
+                         "with a quarter of the paper's variance; t1 swept over 0.30-0.46 s around its learned 0.37 s"),
+    "paper": Story("paper", (0.1, 0.2), 0.01,
+                   why="the paper's walker (Table III's CPG, 0.90 s steps): its window map's cheapest window frees "
+                       "the hip from 0.1 to 0.2 s, so the variant starts there with a quarter of the paper's "
+                       "variance; t1 swept around the learned window's",
+                   cost=3.5),  # 0.90 s steps at 0.71 m/s, at 0.5 ms: 3.4 x the plant steps per metre
+}
+
+
+def story_of(gait: str) -> Story:
+    """The story of the gait named `gait` (STORIES)."""
+    if gait not in STORIES:
+        raise ParameterError(f"--gait {gait!r}: a reproduction is written for {sorted(STORIES)}")
+    return STORIES[gait]
 
 
 @dataclass(frozen=True)
@@ -125,9 +174,20 @@ class Reproduction:
     what the run logs record of the cluster."""
 
     def __init__(self, out: Path, profile: Profile, client, workers: int | None = None,
-                 scheduler: str | None = None, log: Callable[[str], None] = print):
+                 scheduler: str | None = None, log: Callable[[str], None] = print, gait: str = "default"):
         self.out, self.profile, self._client = out, profile, client
         self.workers, self.scheduler, self.log = workers, scheduler, log
+        self.story = story_of(gait)
+
+    @property
+    def _gait_title(self) -> str:
+        """The gait as the time-step study's table names it (its own command's words)."""
+        return "Default gait" if self.story.gait == "default" else f"Gait {self.story.gait}"
+
+    @property
+    def base(self) -> EpisodeConfig:
+        """The story's gait as shipped (its own plant step and distance)."""
+        return load_gait(self.story.gait)
 
     def _walking_the_distance(self, base: EpisodeConfig) -> EpisodeConfig:
         return base.replace(sim=dataclasses.replace(base.sim, distance_m=self.profile.distance_m,
@@ -135,11 +195,11 @@ class Reproduction:
 
     @property
     def level(self) -> EpisodeConfig:
-        """The default gait on level ground, walking the profile's distance."""
-        return self._walking_the_distance(EpisodeConfig())
+        """The story's gait on level ground, walking the profile's distance."""
+        return self._walking_the_distance(self.base)
 
     def learned_window(self) -> tuple[tuple[float, float], str, Path | None]:
-        """The default gait's learned torque-free period (t1, t2), where it came from, and the learning record
+        """The story gait's learned torque-free period (t1, t2), where it came from, and the learning record
         it came from: the best learned trial of `learn` (the paper's settings), else of `learn_variant`; else the
         window map's cheapest, else LEVEL_WINDOW (no record)."""
         from drake_biped.common.learning_record import best_learned_trial
@@ -216,7 +276,7 @@ class Reproduction:
         return self.experiment("paper_gait", {"config": config.to_dict()}, run)
 
     def table_iii(self) -> dict:
-        """Table III's CPG with the default gait's other gains, from the paper's initiation (the grid runs it
+        """Table III's CPG with the story gait's other gains, from the paper's initiation (the grid runs it
         too; the quick run runs it alone)."""
         from drake_biped.common.executor import run_kept
 
@@ -298,7 +358,8 @@ class Reproduction:
             # walks too short for a long-run mean (a small profile) compare the whole walk's C_mt, and say so
             measure = "long-run" if has_long_run(p.time_step_distance_m) else "episode"
             rec = time_step.run(time_step.TimeStepSettings(tuple(p.time_steps), min(p.time_steps),
-                                                           p.time_step_distance_m, windows=windows, measure=measure),
+                                                           p.time_step_distance_m, config=self.base,
+                                                           gait=self._gait_title, windows=windows, measure=measure),
                                 folder, self._client, progress=False)
             return {"chosen_step_s": rec["chosen_step_s"], "passing_steps": rec["passing_steps"]}
 
@@ -363,7 +424,7 @@ class Reproduction:
 
     def learn_variant(self) -> dict:
         trials, episodes = self.profile.learn_variant
-        return self._learn("learn_variant", trials, episodes, (0.4, 0.4), 0.01)
+        return self._learn("learn_variant", trials, episodes, self.story.variant_start, self.story.variant_variance)
 
     def stability(self) -> dict:
         from drake_biped.experiments import stability
@@ -448,10 +509,10 @@ class Reproduction:
         def run(folder: Path) -> dict:
             import numpy as np
 
-            level = EpisodeConfig().replace(window=learned)
+            level = self.base.replace(window=learned)
             walks = sweep(folder / "learned", level, "t2", (0.0, window[1]), long_m)  # t2 0: no window
-            t1 = sweep(folder / "t1", level, "t1", np.linspace(0.30, 0.46, n_t1), sweep_m)
-            up = EpisodeConfig().replace(ground=Ground(slope_rad=0.0, level_length_m=2.0))
+            t1 = sweep(folder / "t1", level, "t1", self.story.t1_values(window, n_t1), sweep_m)
+            up = self.base.replace(ground=Ground(slope_rad=0.0, level_length_m=2.0))
             slopes = np.round(np.linspace(0.005, 0.005 * n_slopes, n_slopes), 4)
             slope = {name: sweep(folder / f"slope_{name}", up.replace(window=w), "slope", slopes, slope_m,
                                  transient_m=2.0, lyapunov=False)
@@ -460,7 +521,7 @@ class Reproduction:
             paper = sweep(folder / "paper_entrained", entrained, "speed", (entrained.initial.speed_mps,), sweep_m,
                           second_time_step_s=0.5 * entrained.sim.time_step_s)
             slice_ = basins.run(basins.BasinSettings(
-                EpisodeConfig().override({"sim.distance_m": basin_m, "sim.max_time_s": 6.0 * basin_m}), window,
+                self.base.override({"sim.distance_m": basin_m, "sim.max_time_s": 6.0 * basin_m}), window,
                 tuple(np.round(np.linspace(0.10, 0.16, n_starts), 4)),
                 tuple(np.round(np.linspace(0.14, 0.21, n_starts), 4)),
                 transient_m=min(bifurcation.TRANSIENT_M, 0.4 * basin_m)), folder / "basins", self._client,
@@ -485,7 +546,7 @@ class Reproduction:
         return self.experiment("dynamics", settings, run)
 
     def slope_axes(self) -> list:
-        """The 2.0 deg grid's axes around the default gait (SLOPE_2DEG_*): its torso leaned further forward, a
+        """The 2.0 deg grid's axes around the story's gait (SLOPE_2DEG_*): its torso leaned further forward, a
         larger placement gain, and u_a, u_r, kappa raised as in Table VII; or the 2 x 2 corner of lean and u_a."""
         from drake_biped.experiments.grid import Axis
 
@@ -500,7 +561,7 @@ class Reproduction:
                 *raised]
 
     def grid_slope2deg(self) -> dict:
-        """Table VII: the default gait's grid (slope_axes) on 2 m level then 2.0 deg."""
+        """Table VII: the story gait's grid (slope_axes) on 2 m level then 2.0 deg."""
         from drake_biped.experiments import grid
         from drake_biped.experiments.slope import slope_ground
 
@@ -508,7 +569,7 @@ class Reproduction:
         settings = {"axes": {a.name: list(a.values) for a in axes}, "slope_rad": SLOPE_2DEG_RAD_PRINTED}
 
         def run(folder: Path) -> dict:
-            base = EpisodeConfig().replace(ground=slope_ground(SLOPE_2DEG_RAD_PRINTED))
+            base = self.base.replace(ground=slope_ground(SLOPE_2DEG_RAD_PRINTED))
             record = grid.run(grid.GridSettings(base, tuple(axes)), folder, self._client, progress=False,
                               workers=self.workers, scheduler=self.scheduler)
             return {"points": record["points"], "walked": record["walked_the_distance"], "best": record["best"],
@@ -517,7 +578,7 @@ class Reproduction:
         return self.experiment("grid_slope2deg", settings, run)
 
     def _slope(self, name: str, slope: float, point: dict[str, float] | None = None) -> dict:
-        """The slope story on the default gait (with the grid's `point` put in) from the learned window: the
+        """The slope story on the story's gait (with the grid's `point` put in) from the learned window: the
         learner starts from its learning record's state when a trial learned one, else from the window with
         the paper's variance."""
         from drake_biped.experiments import slope as slope_experiment
@@ -525,7 +586,7 @@ class Reproduction:
 
         trials, episodes = self.profile.slope
         window, source, policy = self.learned_window()
-        config = EpisodeConfig() if not point else point_config(EpisodeConfig(), point)
+        config = self.base if not point else point_config(self.base, point)
         settings = {"config": config.to_dict(), "slope_rad": slope, "start": list(window), "start_source": source,
                     "policy": None if policy is None else str(policy.relative_to(self.out)), "variance": 0.04,
                     "trials": trials, "episodes": episodes}
@@ -544,7 +605,7 @@ class Reproduction:
         return self._slope("slope", SLOPE_RAD)
 
     def slope2deg(self) -> dict:
-        """The slope story on 2.0 deg with the 2.0 deg grid's best point (the default gait when none climbs)."""
+        """The slope story on 2.0 deg with the 2.0 deg grid's best point (the gait itself when none climbs)."""
         from drake_biped.analysis.reproduce_report import climbs_2deg
 
         grid = self.summary("grid_slope2deg")
@@ -559,7 +620,7 @@ class Reproduction:
         self.out.mkdir(parents=True, exist_ok=True)
         code = versions()
         summaries = {}
-        for step in steps_of(self.profile):
+        for step in steps_of(self.profile, self.story.gait):
             summaries[step] = getattr(self, step)()
         from drake_biped.analysis.reproduce_report import write_report
 
@@ -568,14 +629,21 @@ class Reproduction:
             from drake_biped.resources import full_run_digest
 
             full_run = full_run_digest()
-        write_report(self.out, summaries, self.profile, code, full_run)
+        write_report(self.out, summaries, self.profile, code, full_run, gait=self.story.gait,
+                     choices=self.story.why)
         return summaries
 
 
-def steps_of(profile: Profile) -> tuple[str, ...]:
-    """The steps a profile runs, in order: its own list, or every step but the quick run's own two (the grid
-    runs Table III; a full run has no full run to check)."""
+def steps_of(profile: Profile, gait: str = "default") -> tuple[str, ...]:
+    """The steps a profile runs on `gait`, in order: its own list, or every step but the quick run's own two
+    (the grid runs Table III; a full run has no full run to check). The shipped full run is checked only on
+    the gait it was measured on."""
+    from drake_biped.analysis.reproduce_report import full_run_gait_name
+    from drake_biped.resources import full_run_digest
+
     chosen = profile.steps or tuple(s for s in Reproduction.STEPS if s not in ("table_iii", "full_run"))
+    if "full_run" in chosen and full_run_gait_name(full_run_digest()) != gait:
+        chosen = tuple(s for s in chosen if s != "full_run")
     return tuple(s for s in Reproduction.STEPS if s in chosen)
 
 
@@ -605,9 +673,13 @@ def _margins(record: dict) -> dict:
 
 @dataclass(frozen=True)
 class ReproduceSettings:
-    """Which profile: QUICK (minutes) or FULL (hours)."""
+    """Which profile, QUICK (minutes) or FULL (hours), on which gait's story (STORIES)."""
 
     profile: Profile = QUICK
+    gait: str = "default"
+
+    def __post_init__(self) -> None:
+        story_of(self.gait)
 
 
 def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = True,
@@ -619,22 +691,27 @@ def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = Tr
     from drake_biped.common.executor import client_or_local
 
     out = Path(out)
-    check_out(out, settings.profile)
+    check_out(out, settings.profile, settings.gait)
     with client_or_local(client) as c:
         return Reproduction(out, settings.profile, c, workers, scheduler,
-                            log=print if progress else (lambda _: None)).run_all()
+                            log=print if progress else (lambda _: None), gait=settings.gait).run_all()
 
 
-def check_out(out: Path, profile: Profile) -> None:
-    """Refuse an output folder that holds another profile's run (its records would refuse to resume)."""
+def check_out(out: Path, profile: Profile, gait: str = "default") -> None:
+    """Refuse an output folder that holds another profile's run, or a run on another gait (its records would
+    be reused for the wrong walker); a folder without a gait recorded holds the default gait's."""
     marker = out / "profile.json"
     kept = read_kept(marker)
     if isinstance(kept, dict):
         saved = kept.get("name")
         if saved != profile.name:
             raise ParameterError(f"--out {out} holds a {saved!r} run; use another folder for a {profile.name!r} run")
+        saved_gait = kept.get("gait", "default")
+        if saved_gait != gait:
+            raise ParameterError(f"--out {out} holds a run on the {saved_gait!r} gait; use another folder for "
+                                 f"--gait {gait}")
     out.mkdir(parents=True, exist_ok=True)
-    write_atomic(marker, profile.to_dict())
+    write_atomic(marker, profile.to_dict() | ({} if gait == "default" else {"gait": gait}))
 
 
 COMMAND = "reproduce"
@@ -647,12 +724,14 @@ PARSER = dict(help="every experiment of the paper and one report beside its numb
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped reproduce`'s options."""
     p.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
+    p.add_argument("--gait", default="default", choices=sorted(STORIES),
+                   help="whose story: the default gait, or `paper` (Table III's CPG, the hip as ODE's motor)")
     add_resumable_run_options(p)
 
 
 def settings_from_args(args: argparse.Namespace) -> ReproduceSettings:
     """The reproduction's settings from the command's options: the quick or the full profile."""
-    return ReproduceSettings(QUICK if args.quick else FULL)
+    return ReproduceSettings(QUICK if args.quick else FULL, args.gait)
 
 
 def command(args: argparse.Namespace) -> int:
@@ -663,10 +742,11 @@ def command(args: argparse.Namespace) -> int:
     profile = settings.profile
     out = Path(args.out)
     check_cluster_options(args.workers, args.scheduler, args.force)  # before the folder is claimed for this profile
-    check_out(out, profile)
-    hours = profile.expected_minutes / 60
-    print(f"reproduce ({profile.name}): {len(steps_of(profile))} experiments into {out}/, expected "
-          "about " + (f"{profile.expected_minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
+    check_out(out, profile, settings.gait)
+    minutes = profile.expected_minutes * story_of(settings.gait).cost
+    hours = minutes / 60
+    print(f"reproduce ({profile.name}, {settings.gait} gait): {len(steps_of(profile, settings.gait))} experiments into {out}/, expected "
+          "about " + (f"{minutes:.0f} min" if hours < 1.5 else f"{hours:.1f} h")
           + " on 2 cores; interrupt at any time and rerun the same command to resume", flush=True)
     with cluster(args) as client:
         run(settings, out, client, workers=args.workers, scheduler=args.scheduler)
