@@ -281,11 +281,3 @@ def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
                   versions=versions())
     write_record(out, "floquet", record, markdown, figure)
     return record
-
-
-
-
-
-
-
-

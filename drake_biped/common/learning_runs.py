@@ -473,15 +473,3 @@ def check_resume(settings: dict[str, Any], out: Path) -> None:
     made with other settings), before any cluster is started."""
     for k in range(settings["trials"]):
         Trial(Path(out), k, settings)
-
-
-
-
-
-
-
-
-
-
-
-

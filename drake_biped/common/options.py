@@ -364,5 +364,3 @@ def add_resumable_run_options(p: argparse.ArgumentParser) -> None:
     """The cluster options and --out of a command that resumes when rerun."""
     add_cluster_options(p)
     p.add_argument("--out", required=True, type=out_folder, help="output folder (rerun the same command to resume)")
-
-
