@@ -610,9 +610,10 @@ def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: 
     plt.close(fig)
 
 
-def _profile_text(p: Any) -> str:
-    if getattr(p, "steps", ()):  # a profile of a few steps says which
-        return f"steps: {', '.join(p.steps)}; learning {p.learn[0]}×{p.learn[1]} episodes"
+def _profile_text(p: Any, ran: list[str] | None = None) -> str:
+    """The profile's sizes; `ran`: the steps this run ran (a profile of a few steps says which)."""
+    if getattr(p, "steps", ()):
+        return f"steps: {', '.join(ran if ran is not None else p.steps)}; learning {p.learn[0]}×{p.learn[1]} episodes"
     return (f"learning {p.learn[0]}×{p.learn[1]} and {p.learn_variant[0]}×{p.learn_variant[1]} episodes, "
             f"{p.stability_trials} trials per stability cell, slope learning {p.slope[0]}×{p.slope[1]}, "
             f"grid {p.grid_points} points per Table IV range")
@@ -756,13 +757,14 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
     lines = [
         "# drake-biped: the paper reproduced — quick run, beside the shipped full run",
         "",
-        f"Profile **quick** ({_profile_text(profile)}); {len(s)} steps, {wall / 60:.1f} min. drake-biped "
+        f"Profile **quick** ({_profile_text(profile, list(s))}); {len(s)} steps, {wall / 60:.1f} min. drake-biped "
         f"{code.get('drake_biped')} ({code.get('git_commit')}), Drake {code.get('drake')}. This run is too small "
         "to judge most of the paper's claims (learning needs hundreds of episodes, a stability cell several "
         "trials): where it cannot, its column says so, and the full run's verdict stands beside it, "
         f"from the records shipped with the package (full run: drake-biped {full_code.get('git_commit')}, "
-        f"Drake {full_code.get('drake')}). The full run's learned windows, and no window, were walked again "
-        "here: where they give the C_mt the full run recorded, its row says so (✓).",
+        f"Drake {full_code.get('drake')})."
+        + (" The full run's learned windows, and no window, were walked again here: where they give the C_mt the "
+           "full run recorded, its row says so (✓)." if fr else ""),
         "",
     ]
     if other is not None:
