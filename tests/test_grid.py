@@ -6,12 +6,12 @@ import math
 
 import pytest
 
+from drake_biped.analysis.grid_ranking import better, rank
 from drake_biped.cli import main
 from drake_biped.experiments.grid import (
     INITIATION_RANGES,
     TABLE_IV,
     Axis,
-    better,
     cell_centres,
     grid_points,
     load_spec,
@@ -95,6 +95,15 @@ def test_best_is_furthest_then_cheapest():
     assert better(far, {"distance_m": 4.0, "cost_of_transport": 0.1})
     assert better({"distance_m": 5.001, "cost_of_transport": 0.2}, far)  # same centimetre: lower C_mt
     assert not better({"distance_m": 5.0, "cost_of_transport": None}, far)
+
+
+def test_a_walk_ranks_among_the_grids_by_the_same_order():
+    rows = [{"distance_m": d, "cost_of_transport": c} for d, c in
+            ((10.0, 0.30), (10.0, 0.20), (9.999, 0.25), (3.0, 0.1), (10.0, None), (0.4, None))]
+    assert rank({"distance_m": 10.0, "cost_of_transport": 0.22}, rows) == 2  # after 0.20 only
+    assert rank({"distance_m": 10.0, "cost_of_transport": 0.20}, rows) == 1  # a tie shares the rank
+    assert rank({"distance_m": 10.0, "cost_of_transport": 0.35}, rows) == 4  # 0.25 at 9.999 m is the same 10.00 m
+    assert rank({"distance_m": 0.1, "cost_of_transport": None}, rows) == 7
 
 
 def _lines(path):

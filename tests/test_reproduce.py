@@ -360,3 +360,18 @@ def test_the_2deg_grid_raises_the_default_gaits_cpg_as_table_vii_does():
     assert set(quick) == {"gait.torso_pitch_rad", "cpg.u_a"} and all(len(v) == 2 for v in quick.values())
     paper = {a.name: a.values for a in Reproduction(Path("."), FULL, None, gait="paper").slope_axes()}
     assert paper["cpg.u_a"] == (2.0, 2.5) and paper["cpg.u_r"] == (2.1, 2.625) and paper["cpg.kappa"] == (1.8, 2.25)
+
+
+def test_table_iii_ranks_among_the_grids_points_by_the_grids_order(tmp_path):
+    import json
+
+    from drake_biped.analysis.reproduce_report import table_iii_rank
+
+    assert table_iii_rank(tmp_path) is None
+    (tmp_path / "grid").mkdir()
+    rows = [(10.0, 0.25), (10.0, 0.18), (4.2, 0.4), (0.3, None)]
+    (tmp_path / "grid" / "points.jsonl").write_text("".join(
+        json.dumps({"key": str(k), "distance_m": d, "cost_of_transport": c}) + "\n" for k, (d, c) in enumerate(rows)))
+    assert table_iii_rank(tmp_path) is None  # no walk of Table III's own
+    (tmp_path / "grid" / "table_iii.json").write_text(json.dumps({"distance_m": 10.0, "cost_of_transport": 0.2193}))
+    assert table_iii_rank(tmp_path) == (2, 5)

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
+from drake_biped.analysis.grid_ranking import better
 from drake_biped.common.options import (
     EPISODE_RECORD_BYTES,
     add_episode_options,
@@ -215,18 +216,6 @@ def point_config(base: EpisodeConfig, point: dict[str, float]) -> EpisodeConfig:
 
 def _key(config: dict[str, Any]) -> str:
     return hashlib.sha1(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
-
-
-def better(a: dict[str, Any], b: dict[str, Any] | None) -> bool:
-    """Whether row a beats row b: further (to the centimetre), then lower C_mt."""
-    if b is None:
-        return True
-    da, db = round(a["distance_m"], 2), round(b["distance_m"], 2)
-    if da != db:
-        return da > db
-    ca = a["cost_of_transport"] if a["cost_of_transport"] is not None else math.inf
-    cb = b["cost_of_transport"] if b["cost_of_transport"] is not None else math.inf
-    return ca < cb
 
 
 def read_points(path: Path) -> dict[str, dict[str, Any]]:
