@@ -19,6 +19,7 @@ LAYERS = {
     "drake_biped.analysis.learner_comparison": PURE,
     "drake_biped.analysis.floquet": PURE,
     "drake_biped.analysis.rewalks": PURE,
+    "drake_biped.analysis.grid_ranking": PURE,
     "drake_biped.params": CORE,
     "drake_biped.resources": CORE,
     "drake_biped.records": CORE,
