@@ -227,7 +227,7 @@ def test_the_packaged_full_run_is_the_shipped_full_runs_verdicts():
 def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
     """A full run measured on another gait than today's default is named by its shipped gait (or "another
     gait"), so that its column is not read as the default gait's; on the default gait, nothing is said."""
-    from drake_biped.analysis.reproduce_report import full_run_gait
+    from drake_biped.analysis.reproduce_report import full_run_gait, full_run_gait_name
     from drake_biped.params import EpisodeConfig
     from drake_biped.resources import load_gait
 
@@ -245,6 +245,10 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
     from drake_biped.resources import full_run_digest
 
     assert full_run_gait(full_run_digest()) is None
+    # the gait a reproduction walks unless told is the one whose full run ships
+    from drake_biped.experiments.reproduce import DEFAULT_GAIT
+
+    assert full_run_gait_name(full_run_digest()) == DEFAULT_GAIT
 
 
 def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
@@ -285,14 +289,15 @@ def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
 def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_numbers(tmp_path):
     """The quick profile's check of the shipped full run: every learned window (and no window) re-walked
     gives the C_mt the full run recorded, to the last digit; its report carries both columns."""
-    quick = Profile(**{**QUICK.to_dict(), "steps": ("walk", "table_iii", "full_run"), "distance_m": 2.0})
+    from drake_biped.analysis.reproduce_report import full_run_gait_name
     from drake_biped.common.executor import dask_client
-
-    with dask_client(workers=2) as client:
-        summaries = Reproduction(tmp_path, quick, client, workers=2, log=lambda _: None).run_all()
-    checks = summaries["full_run"]["checks"]
     from drake_biped.resources import full_run_digest
 
+    quick = Profile(**{**QUICK.to_dict(), "steps": ("walk", "table_iii", "full_run"), "distance_m": 2.0})
+    gait = full_run_gait_name(full_run_digest())  # a quick run checks the full run on the full run's own gait
+    with dask_client(workers=2) as client:
+        summaries = Reproduction(tmp_path, quick, client, workers=2, log=lambda _: None, gait=gait).run_all()
+    checks = summaries["full_run"]["checks"]
     assert set(checks) == set(full_run_digest()["checks"]) >= {"learn", "learn_variant"}
     text = (tmp_path / "report.md").read_text()
     for check in checks.values():
