@@ -307,13 +307,20 @@ def dynamics_section(out: Path, d: dict[str, Any], wtext: str) -> list[str]:
 def table_iii_rank(out: Path) -> tuple[int, int] | None:
     """Where Table III's own walk (grid/table_iii.json) ranks among the grid's points (grid/points.jsonl), by
     the grid's order (further, then cheaper): (rank, walks ranked, Table III's included); None without them."""
+    import gzip
+
     from drake_biped.analysis.grid_ranking import rank
-    from drake_biped.records import read_kept, read_kept_lines
+    from drake_biped.records import read_kept, read_kept_lines, stored
 
     own = read_kept(out / "grid" / "table_iii.json")
-    if not isinstance(own, dict) or not (out / "grid" / "points.jsonl").is_file():
+    points = stored(out / "grid" / "points.jsonl")  # a committed run keeps it compressed
+    if not isinstance(own, dict) or not points.is_file():
         return None
-    rows = read_kept_lines(out / "grid" / "points.jsonl", "a grid point record", lambda r: isinstance(r, dict))
+    if points.suffix == ".gz":
+        with gzip.open(points, "rt") as f:
+            rows = [json.loads(line) for line in f if line.strip()]
+    else:
+        rows = read_kept_lines(points, "a grid point record", lambda r: isinstance(r, dict))
     return rank(own, rows), len(rows) + 1
 
 

@@ -380,3 +380,9 @@ def test_table_iii_ranks_among_the_grids_points_by_the_grids_order(tmp_path):
     assert table_iii_rank(tmp_path) is None  # no walk of Table III's own
     (tmp_path / "grid" / "table_iii.json").write_text(json.dumps({"distance_m": 10.0, "cost_of_transport": 0.2193}))
     assert table_iii_rank(tmp_path) == (2, 5)
+    import gzip  # a committed run's points are compressed
+
+    points = tmp_path / "grid" / "points.jsonl"
+    points.with_name("points.jsonl.gz").write_bytes(gzip.compress(points.read_bytes()))
+    points.unlink()
+    assert table_iii_rank(tmp_path) == (2, 5)
