@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from drake_biped.analysis.rewalks import CHANGES, HOLD_SAVING, headline, markdown, summary
-from drake_biped.common.walks import changed
+from drake_biped.common.walks import changed, rewalk
 from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
 
 
@@ -79,10 +79,30 @@ def test_the_rewalk_command_repeats_a_learning_runs_own_rewalks(tmp_path, client
             rewalks["no_window"]["as_learned"]["cost_of_transport"]} == record["evaluation"]["no_window"]
     assert rewalks["no_window"]["half_step"]["cost_of_transport"] != rewalks["no_window"]["as_learned"]["cost_of_transport"]
     assert "## The learned windows re-walked" in (tmp_path / "learn" / "table_v.md").read_text()
+    assert len(list((tmp_path / "learn" / "rewalks").glob("*.json"))) == 8  # 4 changes x (no window, trial 0)
     assert main(["rewalk", "--policy", str(tmp_path / "learn" / "learning.json"), "--workers", "1",
                  "--out", str(tmp_path / "rw")]) == 0
     again = json.loads((tmp_path / "rw" / "rewalk.json").read_text())
     assert {k: again[k] for k in rewalks} == json.loads(json.dumps(rewalks))
+
+
+def test_an_interrupted_rewalk_resumes_from_the_walks_it_kept(tmp_path, client):
+    """Each walk is kept as it finishes: a rerun reads a kept walk back (a marked one shows its mark), walks
+    again only what is missing, and gives the first record where nothing was changed."""
+    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    learned = [{"trial": 0, "t1": 0.1, "t2": 0.4}]
+    first = rewalk(config, learned, client, distance_m=0.6, keep=tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{c}-{k}.json" for c in CHANGES
+                                                                for k in ("no_window", 0))
+    assert json.dumps(rewalk(config, learned, client, distance_m=0.6, keep=tmp_path)) == json.dumps(first)
+    marked = tmp_path / "half_step-0.json"
+    kept = json.loads(marked.read_text())
+    marked.write_text(json.dumps({**kept, "cost_of_transport": 123.0}))
+    (tmp_path / "speed_0.95-no_window.json").unlink()  # interrupted before this walk finished
+    again = rewalk(config, learned, client, distance_m=0.6, keep=tmp_path)
+    assert again["trials"][0]["walks"]["half_step"]["cost_of_transport"] == 123.0
+    assert again["no_window"]["speed_0.95"] == first["no_window"]["speed_0.95"]
+    assert (tmp_path / "speed_0.95-no_window.json").exists()
 
 
 def test_rewalk_refuses_a_file_that_is_not_a_learning_record(tmp_path, capsys):

@@ -63,6 +63,8 @@ __all__ = ["LearningSettings", "Trial", "best_learned_trial", "check_learning_re
            "check_rewalk_distance", "evaluate", "make_settings", "replay_run", "reward", "run", "run_learning"]
 
 RECORD_VERSION = 1
+# Where a run keeps its final means' re-walks, walk by walk, so that an interrupted evaluation resumes.
+REWALKS_DIR = "rewalks"
 
 
 def trial_seed(seed: int, trial: int) -> int:
@@ -346,14 +348,14 @@ def check_rewalk_distance(settings: dict[str, Any], distance_m: float) -> None:
         raise ParameterError(f"--rewalk-distance {distance_m:g}: {exc}") from None
 
 
-def evaluate(settings: dict[str, Any], trials: list[Trial], client, rewalk_distance_m: float = REWALK_M
-             ) -> dict[str, Any]:
+def evaluate(settings: dict[str, Any], trials: list[Trial], client, rewalk_distance_m: float = REWALK_M,
+             keep: Path | None = None) -> dict[str, Any]:
     """Table V's measured rows: the gait without a window, and with each trial's final policy mean; and every
     one of them re-walked with the plant step halved and from 0.95 and 1.05 x the initiation speed
-    (`drake_biped.common.walks.rewalk`), as "rewalks"."""
+    (`drake_biped.common.walks.rewalk`, each walk kept in the folder `keep` when one is given), as "rewalks"."""
     base = EpisodeConfig.from_dict(settings["config"])
     means = [{"trial": t.index, "t1": float(t.learner.mean[0]), "t2": float(t.learner.mean[1])} for t in trials]
-    rewalks = rewalk(base, means, client, distance_m=rewalk_distance_m)
+    rewalks = rewalk(base, means, client, distance_m=rewalk_distance_m, keep=keep)
     no_window = _as_measured(rewalks["no_window"]["as_learned"])
     learned = [dict(_as_measured(t["walks"]["as_learned"]), trial=t["trial"], t1=t["t1"], t2=t["t2"])
                for t in rewalks["trials"]]
@@ -437,7 +439,8 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
         workers: int | None = None, scheduler: str | None = None, rewalk_distance_m: float | None = None
         ) -> dict[str, Any]:
     """Run or resume the learning on `client` (a LocalCluster when None), evaluate the final policies, and
-    write learning.json, run.json, fig4_reward.png, fig5_cmt.png, fig6_times.png and table_v.md into `out`.
+    write learning.json, run.json, fig4_reward.png, fig5_cmt.png, fig6_times.png and table_v.md into `out`
+    (the re-walks kept walk by walk in `out`/rewalks, so that an interrupted evaluation resumes).
     `settings`: a LearningSettings, or the record dictionary of one. workers/scheduler: what run.json
     records of the cluster. `rewalk_distance_m`: how far the final policy means are re-walked (their long-run
     C_mt is measured from REWALK_M on); None: REWALK_M, or the episodes' own distance when that is under the
@@ -458,7 +461,7 @@ def run(settings: LearningSettings | dict[str, Any], out: Path, client=None, pro
         with client_or_local(client) as c:
             trials, new = run_learning(out, record_settings, c, report)
             report.log.update(new, force=True)
-            evaluation = evaluate(record_settings, trials, c, rewalk_distance_m)
+            evaluation = evaluate(record_settings, trials, c, rewalk_distance_m, keep=out / REWALKS_DIR)
     finally:
         report.close()
     record = learning_record(record_settings, trials, evaluation)

@@ -6,6 +6,7 @@ what a saving and a trial's holding mean is `drake_biped.analysis.rewalks`)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -94,11 +95,13 @@ def changed(config: EpisodeConfig, change: str) -> EpisodeConfig:
 
 
 def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
-           distance_m: float = REWALK_M) -> dict[str, Any]:
+           distance_m: float = REWALK_M, keep: Path | None = None) -> dict[str, Any]:
     """Walk each learned window (`learned`: {"trial", "t1", "t2"}, a policy mean, per trial) and the gait
     without a window, as learned and under each change, `distance_m` each (the long-run C_mt is measured after
-    the first 10 m), on the Dask `client`: the `summary` record."""
-    from drake_biped.common.executor import episode_task
+    the first 10 m), on the Dask `client`: the `summary` record. `keep`: a folder where each walk is kept as it
+    finishes (`{change}-{trial or no_window}.json`) and read back by a rerun, so that an interrupted re-walk
+    resumes; None keeps nothing."""
+    from drake_biped.common.executor import episode_task, run_kept
 
     plain = config.replace(window=TorqueFreeWindow()).override(
         {"sim.distance_m": distance_m, "sim.max_time_s": max(config.sim.max_time_s, 6.0 * distance_m)})
@@ -110,8 +113,12 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
             window = window_of((t["t1"], t["t2"]))
             if window.active:  # an inactive window is the walk without one
                 jobs[change, t["trial"]] = base.replace(window=window).to_dict()
-    futures = {key: client.submit(episode_task, c, pure=False) for key, c in jobs.items()}
-    results = dict(zip(futures, client.gather(list(futures.values()))))
+    if keep is None:
+        futures = {key: client.submit(episode_task, c, pure=False) for key, c in jobs.items()}
+        results = dict(zip(futures, client.gather(list(futures.values()))))
+    else:
+        kept = run_kept(client, {key: (Path(keep) / f"{key[0]}-{key[1]}.json", c) for key, c in jobs.items()})
+        results = {key: kept[key] for key in jobs}  # in the jobs' order, as they were submitted
     rows: dict[str, dict[Any, dict[str, Any]]] = {change: {} for change in CHANGES}
     for (change, key), r in results.items():
         rows[change][key] = {f: r[f] for f in KEEP}

@@ -38,9 +38,9 @@ __all__ = ["RewalkSettings", "rewalk_record", "run"]
 
 
 
-def rewalk_record(source: Path, client) -> dict[str, Any]:
+def rewalk_record(source: Path, client, keep: Path | None = None) -> dict[str, Any]:
     """The re-walks of a learning record's final policy means (`source`: a learning.json), with what they
-    were made from."""
+    were made from; each walk kept in the folder `keep` as it finishes (a rerun resumes), when one is given."""
     record = check_learning_record(read_json(source, "--policy"), f"--policy {source}")
     try:
         config = config_of_record(record["settings"]["config"])
@@ -51,7 +51,7 @@ def rewalk_record(source: Path, client) -> dict[str, Any]:
     # walked as the record's own re-walks were (a record from before re-walks were long: its episodes' length)
     before = (record.get("evaluation") or {}).get("rewalks") or {}
     distance = before.get("distance_m", config.sim.distance_m)
-    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client, distance),
+    return {"source": str(source), "config": config.to_dict(), **rewalk(config, learned, client, distance, keep=keep),
             "versions": versions()}
 
 
@@ -64,13 +64,14 @@ class RewalkSettings:
 
 def run(settings: RewalkSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """The re-walks of the record's final policy means on `client` (a LocalCluster when None); writes
-    rewalk.json and rewalk.md into `out`. The record."""
+    rewalk.json and rewalk.md into `out`, each walk kept in `out`/walks as it finishes (a rerun resumes). The
+    record."""
     from drake_biped.analysis.rewalks import markdown
     from drake_biped.common.executor import client_or_local
 
     check_settings(settings, RewalkSettings, "rewalk.run")
     with client_or_local(client) as c:
-        record = rewalk_record(Path(settings.policy), c)
+        record = rewalk_record(Path(settings.policy), c, keep=Path(out) / "walks")
     out = Path(out)
     write_record(out, "rewalk", record, markdown)
     return record
