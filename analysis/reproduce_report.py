@@ -19,6 +19,7 @@ from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.floquet import record_verdict
+from drake_biped.analysis.rewalks import window_acted
 from drake_biped.analysis.series import cmt_change, signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
@@ -91,8 +92,10 @@ def _read(out: Path, rel: str) -> str:
 
 
 def _windows_kept(evaluation: dict[str, Any]) -> int:
-    """How many trials of a learning evaluation end with a window (t̄2 > t̄1) that walks."""
-    return sum(1 for r in evaluation.get("learned", []) if r["t2"] > max(0.0, r["t1"]) and not r["fell"])
+    """How many trials of a learning evaluation end with a window that frees the hip in a walk
+    (`analysis.rewalks.window_acted`)."""
+    no_window = evaluation.get("no_window")
+    return sum(1 for r in evaluation.get("learned", []) if window_acted(r, no_window) and not r["fell"])
 
 
 def reduction_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:

@@ -22,7 +22,7 @@ from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import measure_text
 from drake_biped.analysis.series import cmt_change, window_text
 
-__all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary"]
+__all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary", "window_acted"]
 
 # The walk as learned, then the changes it is re-walked under.
 CHANGES = ("as_learned", "half_step", "speed_0.95", "speed_1.05")
@@ -32,6 +32,22 @@ CHANGE_WORDS = {"as_learned": "as learned", "half_step": "half the plant step",
 HOLD_SAVING = 0.35
 # What a re-walk keeps of an episode's result.
 KEEP = ("cost_of_transport", "distance_m", "fell", "mean_speed_mps", "step_period_s")
+
+
+# What identifies a walk in an evaluation row: the same simulation gives the same figures to the last digit.
+_WALK = ("cost_of_transport", "distance_m", "mean_speed_mps", "step_period_s")
+
+
+def window_acted(row: dict[str, Any], no_window: dict[str, Any] | None) -> bool:
+    """Whether a trial's final policy mean (an evaluation row) freed the hip in its walk: it has a window
+    (t̄2 > t̄1), and its walk is not the walk without one to the last digit (`no_window`: the evaluation's row;
+    None: not compared). A window that opens only after every step has ended (t̄1 beyond the step period)
+    never frees the hip, and the simulation is the one without it."""
+    if not float(row["t2"]) > max(0.0, float(row["t1"])):
+        return False
+    if not no_window:
+        return True
+    return any(row.get(k) != no_window.get(k) for k in _WALK)
 
 
 def measured_cost(row: dict[str, Any]) -> float | None:
@@ -101,7 +117,11 @@ def markdown(record: dict[str, Any]) -> str:
     lines.append(f"| no window | — | {base} | | |")
     for t in record["trials"]:
         cells = " | ".join(_change(t["savings"][c]) for c in record["changes"])
-        lines.append(f"| {t['trial']} | {window_text(t['t1'], t['t2'])} | {cells} | "
+        window = window_text(t["t1"], t["t2"])
+        as_learned, plain = t["walks"].get("as_learned"), record["no_window"].get("as_learned")
+        if as_learned and plain and not window_acted({**as_learned, "t1": t["t1"], "t2": t["t2"]}, plain):
+            window += " (never opens: the walk is the one without a window)" if "–" in window else ""
+        lines.append(f"| {t['trial']} | {window} | {cells} | "
                      f"{_change(t['mean_saving'])} | "
                      f"{'yes' if t['holds'] else 'no'} |")
     lines += ["", headline(record)]

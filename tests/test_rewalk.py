@@ -42,6 +42,30 @@ def test_a_saving_is_judged_against_no_window_under_the_same_change():
     assert "| no window | — | C_mt 0.2000 | C_mt 0.2500 | C_mt 0.2000 | C_mt 0.1000 | | |" in table
 
 
+def test_a_window_that_never_opens_is_not_a_learned_window():
+    """A final mean (1.85, 1.99) s on a 0.9 s step has t2 > t1 but never frees the hip: its walk is the one
+    without a window to the last digit. It is not the learned window; a mean that changed the walk is, and the
+    re-walk table says which is which."""
+    from drake_biped.analysis.rewalks import window_acted
+    from drake_biped.common.learning_record import best_learned_trial
+
+    plain = {**_row(0.2135), "step_period_s": 0.898}
+    late = {**plain, "trial": 0, "t1": 1.85, "t2": 1.99}
+    acting = {**_row(0.2001), "trial": 1, "t1": 0.1, "t2": 0.2}
+    none = {**plain, "trial": 2, "t1": 0.6, "t2": 0.04}
+    assert not window_acted(late, plain) and window_acted(acting, plain) and not window_acted(none, plain)
+    assert window_acted(late, None)  # nothing to compare with: t2 > t1 decides
+    record = {"evaluation": {"no_window": plain, "learned": [late, acting, none]}}
+    assert best_learned_trial(record)["trial"] == 1
+    record["evaluation"]["learned"] = [late, none]
+    with pytest.raises(ParameterError, match="never frees the hip"):
+        best_learned_trial(record)
+    rows = {c: {"no_window": plain, 0: plain, 1: _row(0.2001)} for c in CHANGES}
+    table = markdown(summary(0.0005, 0.175, [late, acting], rows))
+    assert "| 0 | 1.850–1.990 s (never opens: the walk is the one without a window) |" in table
+    assert "| 1 | 0.100–0.200 s | " in table
+
+
 def test_no_saving_where_the_walk_without_a_window_falls():
     rows = {c: {"no_window": _row(0.2, fell=c == "speed_0.95"), 0: _row(0.1)} for c in CHANGES}
     record = summary(0.001, 0.175, [{"trial": 0, "t1": 0.1, "t2": 0.5}], rows)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from drake_biped.analysis.rewalks import window_acted
 from drake_biped.params import ParameterError
 
 __all__ = ["EPISODE_FIELDS", "best_learned_trial", "check_learning_record"]
@@ -42,15 +43,17 @@ def check_learning_record(record: Any, source: str = "learning.json") -> dict[st
 
 def best_learned_trial(record: dict[str, Any], source: str = "learning.json") -> dict[str, Any]:
     """The learned torque-free period of a learning record: of the trials whose final policy mean has a
-    window (t̄2 > t̄1) and walked the distance in the evaluation, the one with the lowest C_mt (a mean over
-    trials would blend trials that learned a window with trials that learned none). Its evaluation row
-    (trial, t1, t2, cost_of_transport, ...); ParameterError if there is none."""
+    window that acted (`window_acted`: t̄2 > t̄1, and the walk not the one without a window) and walked the
+    distance in the evaluation, the one with the lowest C_mt (a mean over trials would blend trials that
+    learned a window with trials that learned none). Its evaluation row (trial, t1, t2, cost_of_transport,
+    ...); ParameterError if there is none."""
     try:
+        no_window = record["evaluation"].get("no_window")
         rows = [r for r in record["evaluation"]["learned"]
-                if not r["fell"] and r["cost_of_transport"] is not None and float(r["t2"]) > max(0.0, float(r["t1"]))]
+                if not r["fell"] and r["cost_of_transport"] is not None and window_acted(r, no_window)]
     except (KeyError, TypeError, ValueError) as exc:
         raise ParameterError(f"{source}: not a learning record with an evaluation ({exc})") from None
     if not rows:
         raise ParameterError(f"{source}: no trial learned a torque-free period that walks "
-                             "(every final mean has t2 <= t1)")
+                             "(every final mean has t2 <= t1, falls, or never frees the hip)")
     return min(rows, key=lambda r: float(r["cost_of_transport"]))
