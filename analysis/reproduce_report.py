@@ -744,6 +744,15 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
     return rows
 
 
+# Where each gait's committed full run lives in the repository (its report, records and verdicts.json).
+FULL_RUN_RECORDS = {"default": "benchmarks/results/reproduce-full", "paper": "benchmarks/results/reproduce-paper"}
+
+
+def full_run_records(full_run: dict[str, Any] | None) -> str:
+    """The repository folder of the shipped full run (FULL_RUN_RECORDS, by the gait its checks walked)."""
+    return FULL_RUN_RECORDS.get(full_run_gait_name(full_run) or "default", FULL_RUN_RECORDS["default"])
+
+
 def full_run_gait_name(full_run: dict[str, Any] | None) -> str | None:
     """The shipped gait (`--params NAME`) whose CPG, gains and initiation the full run's checks walked:
     "default", another shipped gait's name, or None (another gait, or no checks recorded)."""
@@ -830,7 +839,7 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         for name in s["floquet"]["gaits"]:
             lines += [embed(_read(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
                       f"![Floquet multipliers, {name}](floquet/{name}/floquet.png)", ""]
-    lines += ["The full report with every experiment: `benchmarks/results/reproduce-full/report.md` in the "
+    lines += [f"The full report with every experiment: `{full_run_records(full_run)}/report.md` in the "
               "repository; `drake-biped reproduce --out DIR` (without `--quick`) runs it.", ""]
     return "\n".join(lines)
 

@@ -4,7 +4,7 @@ docs/ holds exactly these pictures, each linked from a document):
     python benchmarks/docs_figures.py --out docs        # make docs-figures
 
 - report_summary_full.png: the full reproduction's verdict table (README, docs/RESULTS.md), from its
-  verdicts.json (benchmarks/results/reproduce-full/), drawn as `drake-biped reproduce` draws report_summary.png.
+  verdicts.json (the shipped full run's records, benchmarks/results/reproduce-GAIT/), drawn as `drake-biped reproduce` draws report_summary.png.
 - walk_frame.png: the README's picture, a still of the full run's 10 m walk at 5 s: its result.json's
   configuration walked again (an episode is deterministic; a walk whose C_mt is not the recorded one is refused,
   so the picture is of the recorded walk).
@@ -16,7 +16,15 @@ import argparse
 import json
 from pathlib import Path
 
-FULL_RUN = Path(__file__).resolve().parent / "results" / "reproduce-full"
+def _full_run() -> Path:
+    """The committed full run whose verdicts the package ships (analysis.reproduce_report.full_run_records)."""
+    from drake_biped.analysis.reproduce_report import full_run_records
+    from drake_biped.resources import full_run_digest
+
+    return Path(__file__).resolve().parents[1] / full_run_records(full_run_digest())
+
+
+FULL_RUN = _full_run()
 FIGURES = ("report_summary_full.png", "walk_frame.png")
 WALK_FRAME_S = 5.0
 

@@ -213,9 +213,10 @@ def test_the_packaged_full_run_is_the_shipped_full_runs_verdicts():
     copies must be the same file."""
     from pathlib import Path
 
+    from drake_biped.analysis.reproduce_report import full_run_records
     from drake_biped.resources import full_run_digest
 
-    shipped = Path(__file__).resolve().parents[1] / "benchmarks" / "results" / "reproduce-full" / "verdicts.json"
+    shipped = Path(__file__).resolve().parents[1] / full_run_records(full_run_digest()) / "verdicts.json"
     if not shipped.is_file():
         pytest.skip("not a checkout")
     import json
@@ -241,6 +242,11 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
     # a run on another gait names the default gait's full run, and nothing when the full run is its own
     assert full_run_gait(digest(EpisodeConfig()), "paper") == "`default`"
     assert full_run_gait(digest(load_gait("paper")), "paper") is None
+    # and the quick report points at the folder of the gait's committed full run
+    from drake_biped.analysis.reproduce_report import full_run_records
+
+    assert full_run_records(digest(load_gait("paper"))) == "benchmarks/results/reproduce-paper"
+    assert full_run_records(digest(EpisodeConfig())) == "benchmarks/results/reproduce-full"
     # a record older than a field (the shipped full run's, before the hip motor's) is read with its default
     from drake_biped.resources import full_run_digest
 
