@@ -16,6 +16,7 @@ import argparse
 import json
 from pathlib import Path
 
+
 def _full_run() -> Path:
     """The committed full run whose verdicts the package ships (analysis.reproduce_report.full_run_records)."""
     from drake_biped.analysis.reproduce_report import full_run_records
