@@ -56,6 +56,7 @@ def test_reference_outside_the_steps_is_refused(tmp_path, capsys):
 def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
     """The study walks the given gait (its CPG and gains kept, its time step replaced) with no window and
     each given window, and its tables list those windows."""
+    from drake_biped.common import executor
     from drake_biped.experiments import time_step
     from drake_biped.resources import load_gait
 
@@ -72,7 +73,7 @@ def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
                  "cost_of_transport": 0.6, "steps": steps(0.5 - c["window"]["end_s"] / 10),
                  "mean_speed_mps": 1.0, "step_period_s": 0.4, "real_time_factor": 5.0} for c in items]
 
-    monkeypatch.setattr(time_step, "map_ordered", fake_map)
+    monkeypatch.setattr(executor, "map_ordered", fake_map)
     rec = time_step.study([0.0005, 0.001], 0.0005, 10.0, None, progress=False, config=gait,
                           windows=[(0.3, 0.7), (0.5, 1.0)])
     assert len(seen) == 6
@@ -91,6 +92,7 @@ def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
 def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp_path, capsys):
     """A robot's 1 kHz loop stays 1 kHz at every plant step of the study; a step that does not divide it is
     refused before any walk, and the default steps are those that divide it."""
+    from drake_biped.common import executor
     from drake_biped.experiments import time_step
     from drake_biped.params import EpisodeConfig
 
@@ -102,7 +104,7 @@ def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp
                  "cost_of_transport": 0.6, "steps": [], "mean_speed_mps": 1.0, "step_period_s": 0.4,
                  "real_time_factor": 5.0} for _ in items]
 
-    monkeypatch.setattr(time_step, "map_ordered", fake_map)
+    monkeypatch.setattr(executor, "map_ordered", fake_map)
     fixed = EpisodeConfig().override({"sim.control_period_s": 1e-3})
     time_step.study([0.00025, 0.0005, 0.001], 0.00025, 10.0, None, progress=False, config=fixed, windows=[])
     assert sorted({(c["sim"]["time_step_s"], c["sim"]["update_period_s"], c["sim"]["controller_clock"])
@@ -122,6 +124,7 @@ def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp
 def test_walks_too_short_for_a_long_run_mean_compare_the_whole_walk_and_say_so(monkeypatch, tmp_path, capsys):
     """A study of 3 m walks is refused unless told to compare the whole walks' C_mt (--measure episode); then its
     report says that is what it compared, and gives no Richardson estimate of two steps."""
+    from drake_biped.common import executor
     from drake_biped.experiments import time_step
 
     with pytest.raises(SystemExit) as exc:
@@ -133,7 +136,7 @@ def test_walks_too_short_for_a_long_run_mean_compare_the_whole_walk_and_say_so(m
                  "cost_of_transport": 0.6 + c["sim"]["time_step_s"], "steps": [], "mean_speed_mps": 1.0,
                  "step_period_s": 0.4, "real_time_factor": 5.0} for c in items]
 
-    monkeypatch.setattr(time_step, "map_ordered", fake_map)
+    monkeypatch.setattr(executor, "map_ordered", fake_map)
     rec = time_step.study([0.001, 0.002], 0.001, 3.0, None, progress=False, windows=[], measure="episode")
     rec.update(versions={"git_commit": "x", "drake": "y"}, date="d")
     text = time_step_report.markdown(rec)

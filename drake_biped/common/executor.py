@@ -274,6 +274,24 @@ def run_kept(
     return results
 
 
+def map_episodes(
+    client: Any,
+    configs: Sequence[dict[str, Any]],
+    keep: Sequence[Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[dict[str, Any]]:
+    """One episode per EpisodeConfig dict, results in the configurations' order; with `keep` (a path per
+    configuration), each result kept at its path as it finishes and read back by a rerun (`run_kept`), so that
+    an interrupted run resumes. progress(done, total) as they come."""
+    if keep is None:
+        return map_ordered(client, episode_task, list(configs),
+                           (lambda n, r: progress(n, len(configs))) if progress else None)
+    if len(keep) != len(configs):
+        raise ValueError(f"map_episodes: {len(keep)} paths for {len(configs)} configurations")
+    kept = run_kept(client, {i: (path, config) for i, (path, config) in enumerate(zip(keep, configs))}, progress)
+    return [kept[i] for i in range(len(configs))]
+
+
 def map_ordered(
     client: Any,
     fn: Callable[[Any], Any],

@@ -106,16 +106,19 @@ def margin_of(forces: list[float], survived: list[list[bool]]) -> float:
     return margin
 
 
-def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, int], None] | None = None
-                ) -> dict[str, Any]:
-    """The survival maps and margins of `settings` on `client`; the record (see the module's text)."""
-    from drake_biped.common.executor import episode_task, map_ordered
+def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, int], None] | None = None,
+                keep: Path | None = None) -> dict[str, Any]:
+    """The survival maps and margins of `settings` on `client`; the record (see the module's text). `keep`: a
+    folder where each walk is kept as it finishes (a rerun resumes); None keeps nothing."""
+    from drake_biped.common.executor import map_episodes
+
+    def paths(names: list[str]) -> list[Path] | None:
+        return None if keep is None else [Path(keep) / f"{name}.json" for name in names]
 
     base, forces, phases = settings.config, settings.forces, settings.phases
     distance = base.sim.distance_m
-    unpushed = map_ordered(client, episode_task,
-                           [base.replace(window=condition_window(c, settings.window), push=None).to_dict()
-                            for c in CONDITIONS])
+    unpushed = map_episodes(client, [base.replace(window=condition_window(c, settings.window), push=None).to_dict()
+                                     for c in CONDITIONS], paths([f"{c}-unpushed" for c in CONDITIONS]))
     out: dict[str, Any] = {"window": list(settings.window), "max_force_n": settings.max_force_n,
                            "force_step_n": settings.force_step_n, "forces_n": forces, "phases": phases,
                            "settle_s": settings.settle_s, "push_duration_s": settings.push_duration_s,
@@ -136,8 +139,8 @@ def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, i
                     push = Push(sign * force, start, settings.push_duration_s)
                     jobs.append(base.replace(window=window, push=push).to_dict())
                     keys.append((condition, direction, i, j))
-    results = map_ordered(client, episode_task, jobs,
-                          (lambda n, r: progress(n, len(jobs))) if progress else None)
+    names = [f"{c}-{d}-{forces[i]:g}N-phase{j}" for c, d, i, j in keys]
+    results = map_episodes(client, jobs, paths(names), progress)
     for m in out["margins"].values():
         for direction in ("forward", "backward"):
             m[direction] = {"margin_n": None, "survived": [[None] * phases for _ in forces],
@@ -165,7 +168,7 @@ def push_margin(settings: PushMarginSettings, client, progress: Callable[[int, i
 
 def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:
     """The survival maps on `client` (a LocalCluster when None); writes push_margin.json, push_margin.md and
-    push_margin.png into `out`. The record."""
+    push_margin.png into `out`, each walk kept in `out`/walks as it finishes (a rerun resumes). The record."""
     check_settings(settings, PushMarginSettings, "push_margin.run")
     from drake_biped.common.executor import client_or_local
     from drake_biped.common.progress import progress_bar
@@ -174,7 +177,7 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
     code = versions()
     with progress_bar(settings.episodes, "push margin", "episode", progress) as tick, \
             client_or_local(client) as c:
-        record = push_margin(settings, c, progress=tick)
+        record = push_margin(settings, c, progress=tick, keep=out / "walks")
     record.update(config=settings.config.to_dict(), versions=code)
     write_record(out, "push_margin", record, markdown, figure)
     return record

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M, has_long_run, long_run_of_record
 from drake_biped.analysis.time_step_report import figure, halving, markdown
-from drake_biped.common.executor import episode_task, map_ordered
+from drake_biped.common.executor import map_episodes
 from drake_biped.common.options import (
     add_clock_option,
     add_cluster_options,
@@ -68,7 +68,10 @@ MEASURES = ("long-run", "episode")
 
 
 def study(steps: list[float], reference: float, distance: float, client, progress: bool = True,
-          config: EpisodeConfig | None = None, windows=None, measure: str = "long-run") -> dict:
+          config: EpisodeConfig | None = None, windows=None, measure: str = "long-run", keep: Path | None = None
+          ) -> dict:
+    """The walks at each step (each kept in the folder `keep` as it finishes, when one is given: a rerun
+    resumes) and what they choose."""
     base = config if config is not None else EpisodeConfig()
     walk_list = WALKS if windows is None else [None, *map(tuple, windows)]
     jobs = []
@@ -80,8 +83,9 @@ def study(steps: list[float], reference: float, distance: float, client, progres
             jobs.append((h, w, base.replace(sim=sim, window=window).to_dict()))
     from tqdm import tqdm
 
+    paths = None if keep is None else [Path(keep) / f"{1e3 * h:g}ms-{_walk_name(w)}.json" for h, w, _ in jobs]
     with tqdm(total=len(jobs), desc="time-step study", unit="episode", disable=not progress) as bar:
-        results = map_ordered(client, episode_task, [j[2] for j in jobs], lambda n, r: bar.update(1))
+        results = map_episodes(client, [j[2] for j in jobs], paths, lambda n, total: bar.update(n - bar.n))
     rows = []
     for (h, w, c), r in zip(jobs, results):
         long_run = _long_run(r)
@@ -105,6 +109,11 @@ def study(steps: list[float], reference: float, distance: float, client, progres
            **choose_step(rows, steps, reference, TOLERANCE)}
     rec["richardson"] = {json.dumps(w): richardson(rows, steps, w) for w in rec["walks"]}
     return rec
+
+
+def _walk_name(window) -> str:
+    """A walk's name in a kept file's: "no_window", or the window's times ("0.1-0.2s")."""
+    return "no_window" if not window else f"{window[0]:g}-{window[1]:g}s"
 
 
 def _long_run(result: dict) -> dict:
@@ -229,7 +238,7 @@ class TimeStepSettings:
 
 def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = True) -> dict:
     """Run the study on `client` (a LocalCluster when None); write time_step_study.json, .md and .png into
-    `out`; return the record."""
+    `out` (each walk kept in `out`/walks as it finishes: a rerun resumes); return the record."""
     check_settings(settings, TimeStepSettings, "time_step.run")
     from drake_biped.common.executor import client_or_local
 
@@ -239,7 +248,7 @@ def run(settings: TimeStepSettings, out: Path, client=None, progress: bool = Tru
     t0 = time.perf_counter()
     with client_or_local(client) as c:
         rec = study(steps, settings.reference_s, settings.distance_m, c, progress, settings.config,
-                    settings.windows, settings.measure)
+                    settings.windows, settings.measure, keep=out / "walks")
     rec.update(gait=settings.gait, date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), versions=versions(), wall_s=time.perf_counter() - t0)
     write_text_atomic(out / "time_step_study.json", json.dumps(rec, indent=2) + "\n")
     replot(out)
