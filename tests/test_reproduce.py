@@ -277,6 +277,11 @@ def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
     values = STORIES["paper"].t1_values((0.1, 0.2), 5)
     assert values[0] == 0.02 and values[-1] == 0.18 and len(set(values)) == 5
     assert STORIES["paper"].t1_values((0.02, 0.3), 3)[0] == 0.0
+    # the time-step study's second window: the default story's is the study's own (its committed run's
+    # settings still match), the paper walker's one of its own map's windows that walk
+    from drake_biped.experiments.time_step import WALKS
+
+    assert STORIES["default"].study_window == WALKS[-1] and STORIES["paper"].study_window == (0.5, 0.6)
     assert "full_run" in steps_of(QUICK) and "full_run" not in steps_of(QUICK, "paper")
     with pytest.raises(ParameterError, match="--gait 'slow'"):
         story_of("slow")
