@@ -183,8 +183,8 @@ def _one_line(exc: BaseException) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command. Exit codes: 0 done; 2 bad input (an option, a file, the model), one line naming it;
-    1 a run that failed, one line; 130 interrupted (Ctrl-C), one line saying how to resume. A traceback
-    only with --debug or DRAKE_BIPED_DEBUG=1."""
+    1 a run that failed, one line; 130 interrupted (Ctrl-C), 143 stopped (SIGTERM, as a batch scheduler or
+    `kill` stops a job), one line saying how to resume. A traceback only with --debug or DRAKE_BIPED_DEBUG=1."""
     parser = build_parser()
     args = parser.parse_args(argv)
     # tqdm's monitor thread, stopped by an atexit hook, prints a traceback of its own when a second Ctrl-C
@@ -196,10 +196,34 @@ def main(argv: list[str] | None = None) -> int:
     out = getattr(args, "out", None)
     again = ("run the same command again to resume: finished work is kept in " + str(out)
              if getattr(args, "resumable", False) and out else "run the same command again")
-    with _failures_as_one_line(f"drake-biped {args.command}", debug, again):
+    with _failures_as_one_line(f"drake-biped {args.command}", debug, again), _sigterm_as_interrupt():
         with _holding_the_out_folder(args):
             return args.func(args)
     return 0  # not reached: a failure leaves by SystemExit
+
+
+class Stopped(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread as Ctrl-C is: the run stops the same way and says how to resume."""
+
+
+@contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    """SIGTERM raises Stopped inside this block (in the main thread; elsewhere nothing changes)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Stopped()
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 @contextmanager
@@ -209,9 +233,11 @@ def _failures_as_one_line(prefix: str, debug: bool, again: str,
     standard error starting with `prefix`, and its exit code."""
     try:
         yield
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         if debug:
             raise
+        if isinstance(exc, Stopped):
+            _exit(143, f"{prefix}: stopped (SIGTERM); {again}")
         _exit(130, f"{prefix}: interrupted; {again}")
     except (ParameterError, ModelError) as exc:
         _remove_empty_made_folders()

@@ -275,6 +275,29 @@ def test_ctrl_c_is_one_line_exit_130_and_the_same_command_resumes(tmp_path):
     assert json.loads((tmp_path / "l" / "run.json").read_text())["episodes"] == done > 0
 
 
+@pytest.mark.slow
+def test_sigterm_to_the_whole_job_is_one_line_exit_143_and_the_same_command_resumes(tmp_path):
+    """As a batch scheduler or `kill` stops a job (SIGTERM to the driver and its workers): one line saying how
+    to resume, exit 143, no traceback, and the episodes finished kept."""
+    argv = [sys.executable, "-m", "drake_biped", "learn", "--trials", "2", "--episodes", "400", "--distance", "1",
+            "--workers", "2", "--out", str(tmp_path / "l")]
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    trials = tmp_path / "l" / "trials"
+    deadline = time.time() + 120
+    while time.time() < deadline and not (trials.is_dir() and any(trials.iterdir())):
+        time.sleep(0.5)
+    time.sleep(2.0)
+    os.killpg(p.pid, signal.SIGTERM)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 143
+    lines = [line for line in err.replace("\r", "\n").splitlines()
+             if line.strip() and not line.startswith("learning")]
+    assert len(lines) == 1 and "stopped (SIGTERM); run the same command again to resume" in lines[0], lines
+    assert "Traceback" not in err
+    done = sum(len(json.loads(t.read_text())["episodes"]) for t in trials.glob("*.json"))
+    assert json.loads((tmp_path / "l" / "run.json").read_text())["episodes"] == done > 0
+
+
 def _api_cases():
     import numpy as np
 
