@@ -353,6 +353,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     window = tuple(s["push_margin"]["settings"]["window"])  # the learned window (Reproduction.learned_window)
     source = s["push_margin"]["window_source"]
     wtext = _window_text(window)
+    wname = window_name(source)
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
     verdicts: list[tuple[str, str, str, str]] = []  # (what, paper, ours, verdict)
 
@@ -383,7 +384,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                      + (f" (best window {format_cost(cl['best_window']['cost_of_transport'], '—')})" if cl["best_window"]
                         else " (no window walks)"), BEYOND))
     stab_ours, stab_verdict = stability_verdict(s["stability"]["cells"])
-    verdicts.append((f"Table VI: stable under ±20 N, none vs the learned window ({wtext})", "all stable", stab_ours,
+    verdicts.append((f"Table VI: stable under ±20 N, none vs {wname} ({wtext})", "all stable", stab_ours,
                      stab_verdict))
     m = s["push_margin"]["margins"]
     verdicts.append(("Push margins (forward / backward)", "survives ±20 N", f"none {_margin(m, 'without', 'forward')} / "
@@ -419,7 +420,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"{code.get('drake')}. Paper: Takita, Azuma & Shibata, *Acquisition of Energy-Efficient Bipedal Walking "
         "Using CPG-Based Reinforcement Learning*. Every claim is measured on one gait, "
         + ("the default" if gait == "default" else f"`{gait}`") + " (its "
-        f"plant step {_ms(s['learn']['settings']['config'])}), with one learned window: {wtext}, {source}. Each row "
+        f"plant step {_ms(s['learn']['settings']['config'])}), with one torque-free window: {wtext}, {source}. Each row "
         "links to its section; every number below is measured by this run, in the folder named in its section."
         + (f" What this gait's story chooses where the paper prints nothing: {choices}." if choices else ""),
         "",
@@ -491,7 +492,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         embed(_read(out, "learn_variant/table_v.md"), "learn_variant"),
         "![Fig. 6, variant](learn_variant/fig6_times.png)",
         "",
-        f"## Pushes and return maps (Table VI, Fig. 7; `stability/`), the learned window {wtext}",
+        f"## Pushes and return maps (Table VI, Fig. 7; `stability/`), {wname} {wtext}",
         "",
         f"Verdict: **{stab_verdict}**. The window: {source}.",
         "",
@@ -503,7 +504,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "| | forward (N) | backward (N) |",
         "|---|---|---|",
         f"| no torque-free period | {_margin(m, 'without', 'forward')} | {_margin(m, 'without', 'backward')} |",
-        f"| the learned window, {wtext} | {_margin(m, 'with', 'forward')} | {_margin(m, 'with', 'backward')} |",
+        f"| {wname}, {wtext} | {_margin(m, 'with', 'forward')} | {_margin(m, 'with', 'backward')} |",
         "",
         "### The periodic orbit and its Floquet multipliers (`floquet/`)",
         "",
@@ -523,8 +524,8 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     lines += [
         "## Slopes (Figs. 8–11, Table VII)",
         "",
-        f"{label[0].upper()}{label[1:]} on 2 m level, then the slope, 10 m in all. The learner starts from the "
-        "learned window "
+        f"{label[0].upper()}{label[1:]} on 2 m level, then the slope, 10 m in all. The learner starts from "
+        f"{wname} "
         f"({wtext}; from its learning record's policy when a trial learned it, else with σ² 0.04).",
         "",
     ]
@@ -591,6 +592,16 @@ def other_gaits_section(gait: str = "default") -> list[str]:
 
 VERDICT_COLOURS = ((REPRODUCED, "#c8e6c9"), (PARTLY, "#ffe0b2"), (DIFFERS, "#ffe0b2"), (NOT_REPRODUCED, "#ffcdd2"),
                    (BEYOND, "#e0e0e0"))
+
+
+def window_name(source: str) -> str:
+    """What the story's window is, in words, from where it came (Reproduction.learned_window's source): "the
+    learned window" when a trial learned it, else "the window map's cheapest window", else (no window of the map
+    walks) "the default gait's learned window"."""
+    if source.startswith("learned"):
+        return "the learned window"
+    return "the window map's cheapest window" if source.startswith("the window map") else \
+        "the default gait's learned window"
 
 
 def _window_text(window) -> str:

@@ -339,13 +339,16 @@ def test_every_shipped_gait_says_why_it_exists_and_the_report_reads_it_from_the_
 def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp_path):
     import json
 
+    from drake_biped.analysis.reproduce_report import window_name
     from drake_biped.experiments.reproduce import LEVEL_WINDOW
 
     r = Reproduction(tmp_path, SMOKE, None, log=lambda _: None)
     assert r.learned_window() == (LEVEL_WINDOW, "no trial learned one and no window of the map walks", None)
+    assert window_name(r.learned_window()[1]) == "the default gait's learned window"
     (tmp_path / "window_map").mkdir()
     (tmp_path / "window_map" / "summary.json").write_text(json.dumps({"best": {"t1": 0.31234, "t2": 0.9}}))
     assert r.learned_window()[:2] == ((0.3123, 0.9), "the window map's cheapest (no trial learned one)")
+    assert window_name(r.learned_window()[1]) == "the window map's cheapest window"  # the report's words
 
     def learned(folder, rows):
         (tmp_path / folder).mkdir(exist_ok=True)
@@ -355,6 +358,7 @@ def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp
 
     learned("learn_variant", [(0.2, 0.6, 0.3, False)])
     assert r.learned_window()[:2] == ((0.2, 0.6), "learned (learn_variant, trial 0)")
+    assert window_name(r.learned_window()[1]) == "the learned window"
     # the paper's settings first; of its trials the cheapest that walks with a window
     learned("learn", [(0.4, 0.3, 0.1, False), (0.41, 1.0, 0.2, True), (0.43, 1.05, 0.25, False),
                       (-0.1, 0.9, 0.22, False)])
