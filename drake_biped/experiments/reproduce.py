@@ -111,8 +111,8 @@ STORIES = {
     "paper": Story("paper", (0.1, 0.2), 0.01,
                    why="the paper's walker (Table III's CPG, 0.90 s steps): its window map's cheapest window frees "
                        "the hip from 0.1 to 0.2 s, so the variant starts there with a quarter of the paper's "
-                       "variance; t1 swept around the learned window's; its time-step study refines, beside it, the "
-                       "map's cheapest window late in the step (0.5-0.6 s)",
+                       "variance; t1 swept around the story's window (the learned one, else the map's cheapest); its "
+                       "time-step study refines, beside it, the map's window late in the step (0.5-0.6 s)",
                    cost=3.5,  # 0.90 s steps at 0.71 m/s, at 0.5 ms: 3.4 x the plant steps per metre
                    study_window=(0.5, 0.6)),
 }
