@@ -396,10 +396,10 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         verdicts += dynamics_rows(s["dynamics"], wtext)
     on_2deg = ("with the grid's best" if climbs_2deg(s["grid_slope2deg"])
                else f"on {label} (no grid point climbs)")
-    for name, label in (("slope", "Slope story, 0.02 rad (Figs. 8–9)"),
+    for name, claim in (("slope", "Slope story, 0.02 rad (Figs. 8–9)"),
                         ("slope2deg", f"Slope story, 2.0° {on_2deg} (Figs. 10–11)")):
         ours, verdict = slope_verdict(s[name])
-        verdicts.append((label, "all three claims", ours, verdict))
+        verdicts.append((claim, "all three claims", ours, verdict))
     vii_rows, vii_changes, vii_verdict = table_vii_rows(s["grid_slope2deg"])
     verdicts.append(("Table VII: CPG parameters for 2.0°", "u_a +37 %, u_r +25 %, κ +51 %", vii_changes,
                      vii_verdict))

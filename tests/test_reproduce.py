@@ -401,3 +401,25 @@ def test_table_iii_ranks_among_the_grids_points_by_the_grids_order(tmp_path):
     points.with_name("points.jsonl.gz").write_bytes(gzip.compress(points.read_bytes()))
     points.unlink()
     assert table_iii_rank(tmp_path) == (2, 5)
+
+
+def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monkeypatch):
+    """The report of the committed full run's records names its gait where a section names the gait (a loop
+    over the slope claims once left its last claim's words in the grid and window-map sections)."""
+    from drake_biped.analysis import reproduce_report
+    from drake_biped.analysis.reproduce_report import full_run_records, report_markdown
+    from drake_biped.experiments.reproduce import FULL, STORIES
+    from drake_biped.records import read_kept
+    from drake_biped.resources import full_run_digest
+
+    out = Path(__file__).resolve().parents[1] / full_run_records(full_run_digest())
+    if not out.is_dir():
+        pytest.skip("not a checkout")
+    summaries = {step: read_kept(out / step / "summary.json") for step in steps_of(FULL, "default")}
+    monkeypatch.setattr(reproduce_report, "summary_figure", lambda *a, **k: None)  # the records stay as committed
+    text, verdicts = report_markdown(out, summaries, FULL, {}, "default", STORIES["default"].why)
+    assert "## Torque-free windows of the default gait (`window_map/`)" in text
+    assert "Table III itself (with the default gait's other gains)" in text
+    assert "Slope story" not in text.split("## Experiment 1")[0].split("| what | paper |")[0]
+    assert [v[0] for v in verdicts if v[0].startswith("Slope story")] == [
+        "Slope story, 0.02 rad (Figs. 8–9)", "Slope story, 2.0° with the grid's best (Figs. 10–11)"]
