@@ -294,8 +294,10 @@ def test_sigterm_to_the_whole_job_is_one_line_exit_143_and_the_same_command_resu
              if line.strip() and not line.startswith("learning")]
     assert len(lines) == 1 and "stopped (SIGTERM); run the same command again to resume" in lines[0], lines
     assert "Traceback" not in err
+    # the workers die at once, so the run log may miss the episodes finished as the signal came; the trial
+    # records hold them, and a rerun counts them (test_the_run_log_counts_the_episodes_a_killed_session_never_logged)
     done = sum(len(json.loads(t.read_text())["episodes"]) for t in trials.glob("*.json"))
-    assert json.loads((tmp_path / "l" / "run.json").read_text())["episodes"] == done > 0
+    assert 0 < json.loads((tmp_path / "l" / "run.json").read_text())["episodes"] <= done
 
 
 def _api_cases():
