@@ -101,7 +101,7 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
     the first 10 m), on the Dask `client`: the `summary` record. `keep`: a folder where each walk is kept as it
     finishes (`{change}-{trial or no_window}.json`) and read back by a rerun, so that an interrupted re-walk
     resumes; None keeps nothing."""
-    from drake_biped.common.executor import episode_task, run_kept
+    from drake_biped.common.executor import map_episodes
 
     plain = config.replace(window=TorqueFreeWindow()).override(
         {"sim.distance_m": distance_m, "sim.max_time_s": max(config.sim.max_time_s, 6.0 * distance_m)})
@@ -113,12 +113,9 @@ def rewalk(config: EpisodeConfig, learned: list[dict[str, Any]], client,
             window = window_of((t["t1"], t["t2"]))
             if window.active:  # an inactive window is the walk without one
                 jobs[change, t["trial"]] = base.replace(window=window).to_dict()
-    if keep is None:
-        futures = {key: client.submit(episode_task, c, pure=False) for key, c in jobs.items()}
-        results = dict(zip(futures, client.gather(list(futures.values()))))
-    else:
-        kept = run_kept(client, {key: (Path(keep) / f"{key[0]}-{key[1]}.json", c) for key, c in jobs.items()})
-        results = {key: kept[key] for key in jobs}  # in the jobs' order, as they were submitted
+    keys = list(jobs)
+    paths = None if keep is None else [Path(keep) / f"{change}-{key}.json" for change, key in keys]
+    results = dict(zip(keys, map_episodes(client, [jobs[k] for k in keys], paths)))
     rows: dict[str, dict[Any, dict[str, Any]]] = {change: {} for change in CHANGES}
     for (change, key), r in results.items():
         rows[change][key] = {f: r[f] for f in KEEP}
