@@ -301,6 +301,23 @@ class GaitParams(_Validated):
             raise ParameterError(f"GaitParams.hip_joint = {self.hip_joint!r} reads the motor's joint: it changes "
                                  "nothing under hip_drive 'servo'")
 
+    # What each reading leaves unread: the controller never reads these fields under it.
+    UNREAD_BY_MOTOR = ("swing_reading", "swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain",
+                       "placement_velocity_gain")  # the swing reference and its servo: ODE's motor has no angle
+    UNREAD_BY_SERVO = ("motor_limit_nm",)
+    UNREAD_BY_ENTRAINED = ("touchdown_min_phase",)  # the phase does not follow the steps
+
+    def unread(self) -> tuple[str, ...]:
+        """The fields this gait's readings leave unread (`hip_drive`, `phase_reading`): a value given to one
+        of them changes no walk."""
+        names = self.UNREAD_BY_MOTOR if self.hip_drive == "motor" else self.UNREAD_BY_SERVO
+        return names + (self.UNREAD_BY_ENTRAINED if self.phase_reading == "entrained" else ())
+
+    def as_walked(self) -> GaitParams:
+        """These gains as the controller reads them: each unread field (`unread`) at its default."""
+        defaults = {f.name: f.default for f in fields(self)}
+        return dataclasses.replace(self, **{name: defaults[name] for name in self.unread()})
+
 
 @dataclass(frozen=True)
 class InitialConditions(_Validated):
@@ -630,8 +647,9 @@ class EpisodeConfig(_Validated):
 
     def as_walked(self) -> EpisodeConfig:
         """This configuration as the walk sees it: a window that never opens (t2 <= t1), a push of no force or
-        no duration, a level stretch before a level ground, and the seed (no episode draws on it) put in their
-        one no-op form. Two configurations whose `as_walked()` are equal walk the same episode: what a sweep,
+        no duration, a level stretch before a level ground, the seed (no episode draws on it) put in their
+        one no-op form, and the gait's fields its readings leave unread at their defaults (`GaitParams.unread`:
+        the servo's gains under the hip motor, the motor's limit under the servo). Two configurations whose `as_walked()` are equal walk the same episode: what a sweep,
         a grid axis or an option that changes nothing is told by."""
         window = self.window if self.window.active else TorqueFreeWindow(first_step=TorqueFreeWindow().first_step)
         push = self.push if (self.push is not None and self.push.force_n != 0.0 and self.push.duration_s > 0.0
@@ -639,7 +657,7 @@ class EpisodeConfig(_Validated):
         ground = self.ground
         if ground.slope_rad == 0.0 and ground.level_length_m is not None:
             ground = dataclasses.replace(ground, level_length_m=None)
-        return dataclasses.replace(self, window=window, push=push, ground=ground, seed=0)
+        return dataclasses.replace(self, window=window, push=push, ground=ground, gait=self.gait.as_walked(), seed=0)
 
     def replace(self, **changes: Any) -> EpisodeConfig:
         """A copy with whole sections (or the seed) replaced: `config.replace(window=TorqueFreeWindow(0.2, 0.5))`."""

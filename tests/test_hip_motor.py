@@ -118,3 +118,29 @@ def test_the_paper_gait_walks_table_iii_with_the_paper_hip():
     for force in (20.0, -20.0):
         r = run_episode(paper.replace(push=Push(force, 0.4, 0.1)))
         assert not r.fell and r.distance_m >= 10.0
+
+
+def test_the_fields_a_reading_leaves_unread_change_no_walk_and_a_grid_refuses_them():
+    """Under the hip motor the servo's gains and the swing reference's terms are unread (GaitParams.unread):
+    changed, the walk is the same to the last digit and `as_walked` says so; the motor's limit is read and
+    changes the walk. A grid axis over an unread gain is refused before any work."""
+    from drake_biped.experiments.grid import Axis, check_axes
+    from drake_biped.params import ParameterError
+    from drake_biped.resources import load_gait
+
+    paper = load_gait("paper").override({"sim.distance_m": 10.0, "sim.max_time_s": 2.0})
+    assert set(paper.gait.unread()) >= {"hip_kp", "placement_gain"} and "motor_limit_nm" not in paper.gait.unread()
+    assert "motor_limit_nm" in EpisodeConfig().gait.unread()
+
+    def walked(config):
+        r = run_episode(config, cache=None)
+        return r.distance_m, r.positive_work_j, r.touchdowns["touchdown_time_s"].tolist()
+
+    base = walked(paper)
+    unread = paper.override({"gait.hip_kp": 10.0, "gait.placement_gain": 2.0, "gait.swing_offset_rad": 0.3,
+                             "gait.swing_reading": "anchored"})
+    assert unread.as_walked() == paper.as_walked() and walked(unread) == base
+    read = paper.override({"gait.motor_limit_nm": 0.5 * paper.gait.motor_limit_nm})
+    assert read.as_walked() != paper.as_walked() and walked(read) != base
+    with pytest.raises(ParameterError, match="axis gait.placement_gain .* changes nothing"):
+        check_axes(paper, [Axis("gait.placement_gain", (0.1, 0.5))])

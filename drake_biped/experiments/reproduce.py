@@ -555,7 +555,8 @@ class Reproduction:
 
     def slope_axes(self) -> list:
         """The 2.0 deg grid's axes around the story's gait (SLOPE_2DEG_*): its torso leaned further forward, a
-        larger placement gain, and u_a, u_r, kappa raised as in Table VII; or the 2 x 2 corner of lean and u_a."""
+        larger placement gain (where the gait reads one: not under the hip motor), and u_a, u_r, kappa raised as in
+        Table VII; or the 2 x 2 corner of lean and u_a."""
         from drake_biped.experiments.grid import Axis
 
         g, c = self.level.gait, self.level.cpg
@@ -565,8 +566,9 @@ class Reproduction:
                   for k in ("u_a", "u_r", "kappa")]
         if not self.profile.slope_grid_full:
             return [Axis(lean.name, (lean.values[0], lean.values[2])), raised[0]]
-        return [lean, Axis("gait.placement_gain", (g.placement_gain, round(g.placement_gain + SLOPE_2DEG_PLACEMENT, 4))),
+        axes = [lean, Axis("gait.placement_gain", (g.placement_gain, round(g.placement_gain + SLOPE_2DEG_PLACEMENT, 4))),
                 *raised]
+        return [a for a in axes if a.name.removeprefix("gait.") not in g.unread()]  # an unread gain walks alike
 
     def grid_slope2deg(self) -> dict:
         """Table VII: the story gait's grid (slope_axes) on 2 m level then 2.0 deg."""
