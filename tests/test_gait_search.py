@@ -562,3 +562,16 @@ def test_a_search_stops_once_the_objective_maximum_is_reached(tmp_path, client, 
     search(GaitSearchSettings(falling, generations=1, offspring=2, sigma=0.3, seed=2, distance_m=0.3,
                               objective="walk"), tmp_path / "falls", client, progress=False)
     assert [r["generation"] for r in _read_log(tmp_path / "falls" / "search.jsonl")][:2] == [0, 1]
+
+
+def test_a_search_over_gains_its_gait_leaves_unread_is_refused_naming_them_and_the_sets_that_fit():
+    """The servo's gains do not act under the hip motor (GaitParams.unread), nor the motor's limit under the
+    servo: a mutation set that moves them is refused before any work, with the sets that fit."""
+    from drake_biped.params import ParameterError
+    from drake_biped.resources import load_gait
+
+    with pytest.raises(ParameterError, match=r"'paper' move hip_kp.*unread \(hip_drive 'motor'\).*\['paper_motor'\]"):
+        GaitSearchSettings(config=load_gait("paper"), mutations="paper")
+    with pytest.raises(ParameterError, match="'paper_motor' move motor_limit_nm"):
+        GaitSearchSettings(mutations="paper_motor")
+    GaitSearchSettings(config=load_gait("paper"), mutations="paper_motor")  # every gain it moves is read
