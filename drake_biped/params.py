@@ -649,8 +649,9 @@ class EpisodeConfig(_Validated):
         """This configuration as the walk sees it: a window that never opens (t2 <= t1), a push of no force or
         no duration, a level stretch before a level ground, the seed (no episode draws on it) put in their
         one no-op form, and the gait's fields its readings leave unread at their defaults (`GaitParams.unread`:
-        the servo's gains under the hip motor, the motor's limit under the servo). Two configurations whose `as_walked()` are equal walk the same episode: what a sweep,
-        a grid axis or an option that changes nothing is told by."""
+        the servo's gains under the hip motor, the motor's limit under the servo). Two configurations whose
+        `as_walked()` are equal walk the same episode: what a sweep, a grid axis or an option that changes
+        nothing is told by."""
         window = self.window if self.window.active else TorqueFreeWindow(first_step=TorqueFreeWindow().first_step)
         push = self.push if (self.push is not None and self.push.force_n != 0.0 and self.push.duration_s > 0.0
                              and self.push.start_s < self.sim.max_time_s) else None

@@ -724,12 +724,11 @@ class GaitSearchSettings:
                 f"({self.policy_draws!r}) must be >= 1, "
                 f"sigma ({self.sigma!r}) and distance_m ({self.distance_m!r}) > 0"
             )
-        unread = [name for section, name in MUTATION_SETS[self.mutations]
-                  if section == "gait" and name in self.config.gait.unread()]
-        if unread:
-            fits = [k for k, m in MUTATION_SETS.items()
-                    if not any(s == "gait" and n in self.config.gait.unread() for s, n in m)]
-            raise ParameterError(f"mutations {self.mutations!r} move {', '.join(unread)}, which this gait leaves "
+        unread = {("gait", name) for name in self.config.gait.unread()}
+        moved = [name for key in MUTATION_SETS[self.mutations] if key in unread for name in key[1:]]
+        if moved:
+            fits = [k for k, m in MUTATION_SETS.items() if unread.isdisjoint(m)]
+            raise ParameterError(f"mutations {self.mutations!r} move {', '.join(moved)}, which this gait leaves "
                                  f"unread (hip_drive {self.config.gait.hip_drive!r}): they would change nothing; "
                                  f"use one of {fits}")
         check_size(f"--generations {self.generations} x --offspring {self.offspring}",
