@@ -159,7 +159,7 @@ def test_shipped_specs_and_parameter_files_are_valid():
     from drake_biped.resources import gait_names, grid_spec_names, load_gait
 
     sizes = {name: len(grid_points(load_spec(name))) for name in grid_spec_names()}
-    assert sizes == {"around_default": 64, "slope_0.02": 36, "slope_2deg": 64, "tiny": 4}
+    assert sizes == {"around_default": 64, "slope_0.02": 36, "slope_2deg": 64, "slope_2deg_paper": 32, "tiny": 4}
     for name in grid_spec_names():
         for point in grid_points(load_spec(name)):
             point_config(EpisodeConfig(), point)

@@ -124,8 +124,8 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
 
     logs = []
     with dask_client(workers=2) as client:
-        summaries = Reproduction(tmp_path, SMOKE, client, workers=2, log=logs.append).run_all()
-    assert list(summaries) == list(steps_of(SMOKE)) and "full_run" not in summaries
+        summaries = Reproduction(tmp_path, SMOKE, client, workers=2, log=logs.append, gait="default").run_all()
+    assert list(summaries) == list(steps_of(SMOKE, "default")) and "full_run" not in summaries
     text = (tmp_path / "report.md").read_text()
     for heading in SECTIONS:
         assert heading in text, heading
@@ -168,8 +168,8 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     assert summaries["grid_slope2deg"]["base_cpg"] == summaries["learn"]["settings"]["config"]["cpg"]
 
     logs.clear()
-    again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append).run_all()
-    assert logs == [f"[{step}] finished earlier: reused" for step in steps_of(SMOKE)]
+    again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append, gait="default").run_all()
+    assert logs == [f"[{step}] finished earlier: reused" for step in steps_of(SMOKE, "default")]
     assert again == summaries and (tmp_path / "report.md").read_text() == text
     # a full run leaves what a quick run checks: its verdict rows, keyed, and its learned windows' C_mt
     import json
@@ -247,14 +247,12 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
 
     assert full_run_records(digest(load_gait("paper"))) == "benchmarks/results/reproduce-paper"
     assert full_run_records(digest(EpisodeConfig())) == "benchmarks/results/reproduce-full"
-    # a record older than a field (the shipped full run's, before the hip motor's) is read with its default
-    from drake_biped.resources import full_run_digest
-
-    assert full_run_gait(full_run_digest()) is None
     # the gait a reproduction walks unless told is the one whose full run ships
     from drake_biped.experiments.reproduce import DEFAULT_GAIT
+    from drake_biped.resources import full_run_digest
 
     assert full_run_gait_name(full_run_digest()) == DEFAULT_GAIT
+    assert full_run_gait(full_run_digest(), DEFAULT_GAIT) is None
 
 
 def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
@@ -271,7 +269,8 @@ def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
     shipped = load_gait("paper")
     assert paper.base == shipped and paper.level.cpg == shipped.cpg and paper.level.gait == shipped.gait
     assert paper.level.sim == dataclasses.replace(shipped.sim, distance_m=QUICK.distance_m)
-    assert Reproduction(tmp_path, QUICK, None).base == EpisodeConfig()
+    assert Reproduction(tmp_path, QUICK, None, gait="default").base == EpisodeConfig()
+    assert Reproduction(tmp_path, QUICK, None).base == shipped  # the paper's walker unless told
     # the default story's sweep is fixed; the paper's follows the learned window, ending before its t2
     assert STORIES["default"].t1_values((0.37, 0.86), 9)[::8] == (0.30, 0.46)
     values = STORIES["paper"].t1_values((0.1, 0.2), 5)
@@ -282,18 +281,19 @@ def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
     from drake_biped.experiments.time_step import WALKS
 
     assert STORIES["default"].study_window == WALKS[-1] and STORIES["paper"].study_window == (0.5, 0.6)
-    assert "full_run" in steps_of(QUICK) and "full_run" not in steps_of(QUICK, "paper")
+    assert "full_run" in steps_of(QUICK) and "full_run" not in steps_of(QUICK, "default")
     with pytest.raises(ParameterError, match="--gait 'slow'"):
         story_of("slow")
     with pytest.raises(ParameterError, match="--gait 'slow'"):
         ReproduceSettings(QUICK, "slow")
     check_out(tmp_path, QUICK, "paper")
     check_out(tmp_path, QUICK, "paper")
+    check_out(tmp_path, QUICK)  # the paper's walker unless told
     with pytest.raises(ParameterError, match="holds a run on the 'paper' gait"):
-        check_out(tmp_path, QUICK)
-    check_out(tmp_path / "d", QUICK)
+        check_out(tmp_path, QUICK, "default")
+    check_out(tmp_path / "d", QUICK, "default")
     with pytest.raises(ParameterError, match="holds a run on the 'default' gait"):
-        check_out(tmp_path / "d", QUICK, "paper")
+        check_out(tmp_path / "d", QUICK)
 
 
 @pytest.mark.slow
@@ -342,7 +342,7 @@ def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp
     from drake_biped.analysis.reproduce_report import window_name
     from drake_biped.experiments.reproduce import LEVEL_WINDOW
 
-    r = Reproduction(tmp_path, SMOKE, None, log=lambda _: None)
+    r = Reproduction(tmp_path, SMOKE, None, log=lambda _: None, gait="default")
     assert r.learned_window() == (LEVEL_WINDOW, "no trial learned one and no window of the map walks", None)
     assert window_name(r.learned_window()[1]) == "the default gait's learned window"
     (tmp_path / "window_map").mkdir()
@@ -370,18 +370,22 @@ def test_the_2deg_grid_raises_the_default_gaits_cpg_as_table_vii_does():
     from drake_biped.params import EpisodeConfig
 
     c, g = EpisodeConfig().cpg, EpisodeConfig().gait
-    axes = {a.name: a.values for a in Reproduction(Path("."), FULL, None).slope_axes()}
+    axes = {a.name: a.values for a in Reproduction(Path("."), FULL, None, gait="default").slope_axes()}
     assert len(axes) == 5 and math.prod(len(v) for v in axes.values()) == 64
     for k in ("u_a", "u_r", "kappa"):
         assert axes[f"cpg.{k}"] == (getattr(c, k), round(1.25 * getattr(c, k), 4))
     assert axes["gait.torso_pitch_rad"][0] == g.torso_pitch_rad and max(axes["gait.torso_pitch_rad"]) == \
         g.torso_pitch_rad  # leaning further forward only
-    quick = {a.name: a.values for a in Reproduction(Path("."), SMOKE, None).slope_axes()}
+    quick = {a.name: a.values for a in Reproduction(Path("."), SMOKE, None, gait="default").slope_axes()}
     assert set(quick) == {"gait.torso_pitch_rad", "cpg.u_a"} and all(len(v) == 2 for v in quick.values())
-    paper = {a.name: a.values for a in Reproduction(Path("."), FULL, None, gait="paper").slope_axes()}
+    paper = {a.name: a.values for a in Reproduction(Path("."), FULL, None).slope_axes()}
     assert paper["cpg.u_a"] == (2.0, 2.5) and paper["cpg.u_r"] == (2.1, 2.625) and paper["cpg.kappa"] == (1.8, 2.25)
     # under the hip motor the placement gain is unread: the paper's grid has no axis that walks alike
     assert "gait.placement_gain" not in paper and len(paper) == 4 and "gait.placement_gain" in axes
+    # the shipped spec that gives the step its own command (`grid --params paper --spec slope_2deg_paper`) is it
+    from drake_biped.experiments.grid import load_spec
+
+    assert {a.name: a.values for a in load_spec("slope_2deg_paper")} == paper
 
 
 def test_table_iii_ranks_among_the_grids_points_by_the_grids_order(tmp_path):
@@ -405,23 +409,25 @@ def test_table_iii_ranks_among_the_grids_points_by_the_grids_order(tmp_path):
     assert table_iii_rank(tmp_path) == (2, 5)
 
 
-def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monkeypatch):
-    """The report of the committed full run's records names its gait where a section names the gait (a loop
-    over the slope claims once left its last claim's words in the grid and window-map sections)."""
+@pytest.mark.parametrize("gait", ["paper", "default"])
+def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monkeypatch, gait):
+    """The report of each committed full run's records (the shipped one, the paper's walker's, and the default
+    gait's) names its gait where a section names the gait (a loop over the slope claims once left its last
+    claim's words in the grid and window-map sections)."""
     from drake_biped.analysis import reproduce_report
-    from drake_biped.analysis.reproduce_report import full_run_records, report_markdown
+    from drake_biped.analysis.reproduce_report import FULL_RUN_RECORDS, report_markdown
     from drake_biped.experiments.reproduce import FULL, STORIES
     from drake_biped.records import read_kept
-    from drake_biped.resources import full_run_digest
 
-    out = Path(__file__).resolve().parents[1] / full_run_records(full_run_digest())
+    out = Path(__file__).resolve().parents[1] / FULL_RUN_RECORDS[gait]
     if not out.is_dir():
         pytest.skip("not a checkout")
-    summaries = {step: read_kept(out / step / "summary.json") for step in steps_of(FULL, "default")}
+    summaries = {step: read_kept(out / step / "summary.json") for step in steps_of(FULL, gait)}
     monkeypatch.setattr(reproduce_report, "summary_figure", lambda *a, **k: None)  # the records stay as committed
-    text, verdicts = report_markdown(out, summaries, FULL, {}, "default", STORIES["default"].why)
-    assert "## Torque-free windows of the default gait (`window_map/`)" in text
-    assert "Table III itself (with the default gait's other gains)" in text
+    text, verdicts = report_markdown(out, summaries, FULL, {}, gait, STORIES[gait].why)
+    name = "the default gait" if gait == "default" else f"the `{gait}` gait"
+    assert f"## Torque-free windows of {name} (`window_map/`)" in text
+    assert f"Table III itself (with {name}'s other gains)" in text
     assert "Slope story" not in text.split("## Experiment 1")[0].split("| what | paper |")[0]
     assert [v[0] for v in verdicts if v[0].startswith("Slope story")] == [
         "Slope story, 0.02 rad (Figs. 8–9)", "Slope story, 2.0° with the grid's best (Figs. 10–11)"]

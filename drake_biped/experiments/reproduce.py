@@ -3,10 +3,10 @@
 `drake-biped reproduce --out DIR [--quick]` runs, each into its own folder of DIR and through the same
 functions as its own command:
 
-    walk/            the default gait, 10 m: record, figures, Meshcat HTML and GIF
+    walk/            the story's gait, 10 m: record, figures, Meshcat HTML and GIF
     grid/            Table IV's grid (CPG ranges and the initiation), level ground; and Table III itself
     paper_gait/      the shipped gait `paper`: Table III driving the swing as printed (integrated reading)
-    window_map/      the default gait's torque-free windows against none
+    window_map/      the gait's torque-free windows against none
     learn/           Experiment 1 with the paper's settings (Table V, Figs. 4-6)
     learn_variant/   the same with exploration matched to the gait (start 0.4, 0.4; variance 0.01)
     time_step/       the time-step study: no window, the learned window and 0.3-0.6 s
@@ -18,7 +18,7 @@ functions as its own command:
                      grid's best
     compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
 
-All of it on one gait, the default or `--gait paper` (STORIES: the choices each gait's story makes beyond
+All of it on one gait, the paper's walker `paper` (the default) or `--gait default` (STORIES: the choices each gait's story makes beyond
 the paper's printed settings): "the learned window" is the best trial of `learn` (of `learn_variant` when the
 paper's settings learned none; the window map's cheapest when neither did). The other shipped gaits are named
 in the report's closing section, with why each exists. Then DIR/report.md and DIR/report.html:
@@ -118,8 +118,9 @@ STORIES = {
 }
 
 
-# The gait a reproduction walks unless told: the one whose full run ships (drake_biped/results/full_run.json).
-DEFAULT_GAIT = "default"
+# The gait a reproduction walks unless told: the paper's walker, whose full run ships
+# (drake_biped/results/full_run.json).
+DEFAULT_GAIT = "paper"
 
 
 def story_of(gait: str) -> Story:
@@ -164,14 +165,15 @@ class Profile:
         return dataclasses.asdict(self)
 
 
-# The quick run: the walk, the cheap verdicts (Table III and the paper gait fall in two steps), the shipped
-# full run's learned windows walked again, a few learning episodes and one Floquet orbit. What it is too small
-# to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
+# The quick run: the walk, the cheap verdicts (Table III walked 10 m, or falling in a few steps on the default
+# gait), the shipped full run's learned windows walked again, a few learning episodes and one Floquet orbit
+# (4.3 min on 2 workers on the paper's walker; its minutes below are the default gait's, Story.cost scales them).
+# What it is too small to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
 QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
-                2.0, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
+                1.3, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
-# The full run: about 117 min on 2 workers from scratch (benchmarks/results/reproduce-full/, each step's
-# summary.json), its largest parts the learners' comparison (25 min), GARB's two learning runs (18 and 14 min),
+# The full run: about 117 min on 2 workers from scratch on the default gait (benchmarks/results/reproduce-full/,
+# each step's summary.json; the paper's walker takes Story.cost times as long), its largest parts the learners' comparison (25 min), GARB's two learning runs (18 and 14 min),
 # the push margins (21 min) and the Table IV grid (9 min).
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 5.0, (2, 100), True,
                (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 120.0, compare=(5, 300), rewalk_distance_m=110.0)
@@ -735,7 +737,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped reproduce`'s options."""
     p.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
     p.add_argument("--gait", default=DEFAULT_GAIT, choices=sorted(STORIES),
-                   help="whose story: the default gait, or `paper` (Table III's CPG, the hip as ODE's motor)")
+                   help="whose story: `paper` (the default: Table III's CPG, the hip as ODE's motor), or `default` "
+                        "(the toolkit's default gait, 0.42 s steps)")
     add_resumable_run_options(p)
 
 
