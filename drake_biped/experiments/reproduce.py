@@ -5,11 +5,11 @@ functions as its own command:
 
     walk/            the story's gait, 10 m: record, figures, Meshcat HTML and GIF
     grid/            Table IV's grid (CPG ranges and the initiation), level ground; and Table III itself
-    paper_gait/      the shipped gait `paper`: Table III driving the swing as printed (integrated reading)
+    paper_gait/      the shipped gait `paper`: Table III with the hip as the paper drives it (ODE's motor)
     window_map/      the gait's torque-free windows against none
     learn/           Experiment 1 with the paper's settings (Table V, Figs. 4-6)
-    learn_variant/   the same with exploration matched to the gait (start 0.4, 0.4; variance 0.01)
-    time_step/       the time-step study: no window, the learned window and 0.3-0.6 s
+    learn_variant/   the same with exploration matched to the gait (the story's start; variance 0.01)
+    time_step/       the time-step study: no window, the learned window and the story's second window
     stability/       pushes and return maps, none vs the learned window (Table VI, Fig. 7)
     push_margin/     the largest pushes survived, none vs the learned window
     floquet/         the periodic orbit's Floquet multipliers: none and the learned window
@@ -18,12 +18,12 @@ functions as its own command:
                      grid's best
     compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
 
-All of it on one gait, the paper's walker `paper` (the default) or `--gait default` (STORIES: the choices each gait's story makes beyond
-the paper's printed settings): "the learned window" is the best trial of `learn` (of `learn_variant` when the
-paper's settings learned none; the window map's cheapest when neither did). The other shipped gaits are named
-in the report's closing section, with why each exists. Then DIR/report.md and DIR/report.html:
-every table and figure with the paper's value beside ours and a verdict for each. `--quick` runs every experiment on small settings (minutes on 2 cores); the full run takes
-hours and says so up front.
+All of it on one gait, the paper's walker `paper` (the default) or `--gait default` (STORIES: the choices each
+gait's story makes beyond the paper's printed settings): "the learned window" is the best trial of `learn` (of
+`learn_variant` when the paper's settings learned none; the window map's cheapest when neither did). The other
+shipped gaits are named in the report's closing section, with why each exists. Then DIR/report.md and
+DIR/report.html: every table and figure with the paper's value beside ours and a verdict for each. `--quick`
+runs every experiment on small settings (minutes on 2 cores); the full run takes hours and says so up front.
 
 Nothing lost: each experiment keeps its finished work as its own command does (episodes, trials, grid
 points), and once done its summary in DIR/<name>/summary.json with the settings that made it; a rerun
@@ -173,8 +173,9 @@ QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25
                 1.3, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
 # The full run: about 117 min on 2 workers from scratch on the default gait (benchmarks/results/reproduce-full/,
-# each step's summary.json; the paper's walker takes Story.cost times as long), its largest parts the learners' comparison (25 min), GARB's two learning runs (18 and 14 min),
-# the push margins (21 min) and the Table IV grid (9 min).
+# each step's summary.json; the paper's walker takes Story.cost times as long), its largest parts the learners'
+# comparison (25 min), GARB's two learning runs (18 and 14 min), the push margins (21 min) and the Table IV grid
+# (9 min).
 FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 5.0, (2, 100), True,
                (0.002, 0.001, 0.0005, 0.00025, 0.000125), 110.0, 120.0, compare=(5, 300), rewalk_distance_m=110.0)
 
