@@ -123,7 +123,8 @@ def test_the_paper_gait_walks_table_iii_with_the_paper_hip():
 def test_the_fields_a_reading_leaves_unread_change_no_walk_and_a_grid_refuses_them():
     """Under the hip motor the servo's gains and the swing reference's terms are unread (GaitParams.unread):
     changed, the walk is the same to the last digit and `as_walked` says so; the motor's limit is read and
-    changes the walk. A grid axis over an unread gain is refused before any work."""
+    changes the walk. So for the entrained reading's touchdown threshold, read where the phase is reset. A grid
+    axis over an unread gain is refused before any work."""
     from drake_biped.experiments.grid import Axis, check_axes
     from drake_biped.params import ParameterError
     from drake_biped.resources import load_gait
@@ -142,5 +143,14 @@ def test_the_fields_a_reading_leaves_unread_change_no_walk_and_a_grid_refuses_th
     assert unread.as_walked() == paper.as_walked() and walked(unread) == base
     read = paper.override({"gait.motor_limit_nm": 0.5 * paper.gait.motor_limit_nm})
     assert read.as_walked() != paper.as_walked() and walked(read) != base
+    # the entrained reading leaves the touchdown's phase threshold unread: the CPG runs free of the steps
+    entrained = load_gait("paper_entrained").override({"sim.distance_m": 10.0, "sim.max_time_s": 2.0})
+    assert "touchdown_min_phase" in entrained.gait.unread()
+    moved = entrained.override({"gait.touchdown_min_phase": 3.0})
+    assert moved.as_walked() == entrained.as_walked() and walked(moved) == walked(entrained)
+    reset = entrained.override({"gait.phase_reading": "reset"})  # where the phase is reset, it is read
+    assert "touchdown_min_phase" not in reset.gait.unread()
+    assert walked(reset.override({"gait.touchdown_min_phase": 3.0})) != \
+        walked(reset)
     with pytest.raises(ParameterError, match="axis gait.placement_gain .* changes nothing"):
         check_axes(paper, [Axis("gait.placement_gain", (0.1, 0.5))])

@@ -248,11 +248,11 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
     assert full_run_records(digest(load_gait("paper"))) == "benchmarks/results/reproduce-paper"
     assert full_run_records(digest(EpisodeConfig())) == "benchmarks/results/reproduce-full"
     # the gait a reproduction walks unless told is the one whose full run ships
-    from drake_biped.experiments.reproduce import DEFAULT_GAIT
+    from drake_biped.experiments.reproduce import DEFAULT_STORY
     from drake_biped.resources import full_run_digest
 
-    assert full_run_gait_name(full_run_digest()) == DEFAULT_GAIT
-    assert full_run_gait(full_run_digest(), DEFAULT_GAIT) is None
+    assert full_run_gait_name(full_run_digest()) == DEFAULT_STORY
+    assert full_run_gait(full_run_digest(), DEFAULT_STORY) is None
 
 
 def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):

@@ -62,7 +62,7 @@ from drake_biped.records import read_json, read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-__all__ = ["DEFAULT_GAIT", "FULL", "QUICK", "STORIES", "Profile", "ReproduceSettings", "Reproduction", "Story", "check_out", "run",
+__all__ = ["DEFAULT_STORY", "FULL", "QUICK", "STORIES", "Profile", "ReproduceSettings", "Reproduction", "Story", "check_out", "run",
            "steps_of", "story_of"]
 
 LEVEL_WINDOW = LEARNED_WINDOW_S  # compared with none where no window was learned and none of the map walks
@@ -118,9 +118,10 @@ STORIES = {
 }
 
 
-# The gait a reproduction walks unless told: the paper's walker, whose full run ships
-# (drake_biped/results/full_run.json).
-DEFAULT_GAIT = "paper"
+# The story (its gait's name) a reproduction tells unless told: the paper's walker, whose full run ships
+# (drake_biped/results/full_run.json). Not params.DEFAULT_GAIT, the default gait's gains, which
+# EpisodeConfig() and the other commands walk.
+DEFAULT_STORY = "paper"
 
 
 def story_of(gait: str) -> Story:
@@ -185,7 +186,7 @@ class Reproduction:
     what the run logs record of the cluster."""
 
     def __init__(self, out: Path, profile: Profile, client, workers: int | None = None,
-                 scheduler: str | None = None, log: Callable[[str], None] = print, gait: str = DEFAULT_GAIT):
+                 scheduler: str | None = None, log: Callable[[str], None] = print, gait: str = DEFAULT_STORY):
         self.out, self.profile, self._client = out, profile, client
         self.workers, self.scheduler, self.log = workers, scheduler, log
         self.story = story_of(gait)
@@ -647,7 +648,7 @@ class Reproduction:
         return summaries
 
 
-def steps_of(profile: Profile, gait: str = DEFAULT_GAIT) -> tuple[str, ...]:
+def steps_of(profile: Profile, gait: str = DEFAULT_STORY) -> tuple[str, ...]:
     """The steps a profile runs on `gait`, in order: its own list, or every step but the quick run's own two
     (the grid runs Table III; a full run has no full run to check). The shipped full run is checked only on
     the gait it was measured on."""
@@ -689,7 +690,7 @@ class ReproduceSettings:
     """Which profile, QUICK (minutes) or FULL (hours), on which gait's story (STORIES)."""
 
     profile: Profile = QUICK
-    gait: str = DEFAULT_GAIT
+    gait: str = DEFAULT_STORY
 
     def __post_init__(self) -> None:
         story_of(self.gait)
@@ -710,7 +711,7 @@ def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = Tr
                             log=print if progress else (lambda _: None), gait=settings.gait).run_all()
 
 
-def check_out(out: Path, profile: Profile, gait: str = DEFAULT_GAIT) -> None:
+def check_out(out: Path, profile: Profile, gait: str = DEFAULT_STORY) -> None:
     """Refuse an output folder that holds another profile's run, or a run on another gait (its records would
     be reused for the wrong walker); a folder without a gait recorded holds the default gait's."""
     marker = out / "profile.json"
@@ -737,7 +738,7 @@ PARSER = dict(help="every experiment of the paper and one report beside its numb
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped reproduce`'s options."""
     p.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
-    p.add_argument("--gait", default=DEFAULT_GAIT, choices=sorted(STORIES),
+    p.add_argument("--gait", default=DEFAULT_STORY, choices=sorted(STORIES),
                    help="whose story: `paper` (the default: Table III's CPG, the hip as ODE's motor), or `default` "
                         "(the toolkit's default gait, 0.42 s steps)")
     add_resumable_run_options(p)
