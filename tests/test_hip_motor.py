@@ -150,7 +150,6 @@ def test_the_fields_a_reading_leaves_unread_change_no_walk_and_a_grid_refuses_th
     assert moved.as_walked() == entrained.as_walked() and walked(moved) == walked(entrained)
     reset = entrained.override({"gait.phase_reading": "reset"})  # where the phase is reset, it is read
     assert "touchdown_min_phase" not in reset.gait.unread()
-    assert walked(reset.override({"gait.touchdown_min_phase": 3.0})) != \
-        walked(reset)
+    assert walked(reset.override({"gait.touchdown_min_phase": 3.0})) != walked(reset)
     with pytest.raises(ParameterError, match="axis gait.placement_gain .* changes nothing"):
         check_axes(paper, [Axis("gait.placement_gain", (0.1, 0.5))])

@@ -724,12 +724,17 @@ class GaitSearchSettings:
                 f"({self.policy_draws!r}) must be >= 1, "
                 f"sigma ({self.sigma!r}) and distance_m ({self.distance_m!r}) > 0"
             )
+        # A set that moves gains this gait leaves unread searches dimensions that change nothing; refused where
+        # another set avoids them. A gain every set moves (the touchdown threshold, unread by the entrained
+        # phase) cannot be avoided and is searched as a dimension that changes nothing.
         unread = {("gait", name) for name in self.config.gait.unread()}
-        moved = [name for key in MUTATION_SETS[self.mutations] if key in unread for name in key[1:]]
+        unavoidable = set.intersection(*(unread & set(m) for m in MUTATION_SETS.values()))
+        moved = [name for key in MUTATION_SETS[self.mutations] if key in unread - unavoidable for name in key[1:]]
         if moved:
-            fits = [k for k, m in MUTATION_SETS.items() if unread.isdisjoint(m)]
+            fits = [k for k, m in MUTATION_SETS.items() if unread & set(m) == unavoidable]
             raise ParameterError(f"mutations {self.mutations!r} move {', '.join(moved)}, which this gait leaves "
-                                 f"unread (hip_drive {self.config.gait.hip_drive!r}): they would change nothing; "
+                                 f"unread (hip_drive {self.config.gait.hip_drive!r}, phase_reading "
+                                 f"{self.config.gait.phase_reading!r}): they would change nothing; "
                                  f"use one of {fits}")
         check_size(f"--generations {self.generations} x --offspring {self.offspring}",
                    self.generations * self.offspring, MAX_CANDIDATES, "candidates", self.force)

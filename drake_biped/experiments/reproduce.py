@@ -62,8 +62,8 @@ from drake_biped.records import read_json, read_kept, write_atomic
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
-__all__ = ["DEFAULT_STORY", "FULL", "QUICK", "STORIES", "Profile", "ReproduceSettings", "Reproduction", "Story", "check_out", "run",
-           "steps_of", "story_of"]
+__all__ = ["DEFAULT_STORY", "FULL", "QUICK", "STORIES", "Profile", "ReproduceSettings", "Reproduction", "Story",
+           "check_out", "run", "steps_of", "story_of"]
 
 LEVEL_WINDOW = LEARNED_WINDOW_S  # compared with none where no window was learned and none of the map walks
 SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
