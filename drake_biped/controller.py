@@ -389,20 +389,93 @@ def predicted_touchdown_k(law, s, now: float, clearance: float, c_prev: float, a
 
 
 @njit
+def cholesky_k(a, n: int):
+    """The lower Cholesky factor L (a = L L^T) of the symmetric positive definite n x n matrix `a`, by the
+    Cholesky-Banachiewicz loops in a fixed order: the same rounding on every x86-64 CPU, where a BLAS or LAPACK
+    call picks its kernel (and so its order of operations) per CPU."""
+    low = np.zeros((n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            total = a[i, j]
+            for k in range(j):
+                total -= low[i, k] * low[j, k]
+            if i == j:
+                low[i, i] = math.sqrt(total) if total > 0.0 else math.nan
+            else:
+                low[i, j] = total / low[j, j]
+    return low
+
+
+@njit
+def cholesky_solve_k(low, b, n: int) -> None:
+    """Solve (L L^T) x = b in place, for the columns of b (n x m), by forward and back substitution in a fixed
+    order."""
+    for c in range(b.shape[1]):
+        for i in range(n):
+            total = b[i, c]
+            for k in range(i):
+                total -= low[i, k] * b[k, c]
+            b[i, c] = total / low[i, i]
+        for i in range(n - 1, -1, -1):
+            total = b[i, c]
+            for k in range(i + 1, n):
+                total -= low[k, i] * b[k, c]
+            b[i, c] = total / low[i, i]
+
+
+@njit
 def constrained_inverse_k(dyn) -> tuple:
     """(P, b) from the plant's dynamics `dyn` (DYN_*): P = M^-1 - M^-1 Jc^T (Jc M^-1 Jc^T)^-1 Jc M^-1, the
     generalized accelerations per unit generalized force with the constraints that hold (the stance foot held
     by its contact, a knee at its stop), and b = P f, the accelerations of gravity and the velocity terms
-    alone."""
-    m = np.ascontiguousarray(dyn[DYN_M : DYN_M + 81]).reshape(9, 9)
+    alone. Both Gram matrices (M, Jc M^-1 Jc^T) are symmetric positive definite and solved by Cholesky loops of
+    our own in a fixed order, with no BLAS call, so that a walk gives the same digits on every x86-64 CPU."""
+    n = 9
+    m = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            m[i, j] = dyn[DYN_M + n * i + j]
     rows = int(dyn[DYN_N])
-    jc = np.ascontiguousarray(dyn[DYN_J : DYN_J + 9 * rows]).reshape(rows, 9)
-    f = np.ascontiguousarray(dyn[DYN_F : DYN_F + 9])
-    mi = np.linalg.inv(m)
-    mi_jt = np.ascontiguousarray(mi @ jc.T)
-    k = mi_jt @ np.linalg.inv(jc @ mi_jt)
-    p = mi - k @ np.ascontiguousarray(mi_jt.T)
-    return p, p @ f
+    low = cholesky_k(m, n)
+    mi = np.zeros((n, n))  # M^-1, column by column
+    for i in range(n):
+        mi[i, i] = 1.0
+    cholesky_solve_k(low, mi, n)
+    mi_jt = np.empty((n, rows))  # M^-1 Jc^T
+    for c in range(rows):
+        for i in range(n):
+            mi_jt[i, c] = dyn[DYN_J + n * c + i]
+    cholesky_solve_k(low, mi_jt, n)
+    gram = np.empty((rows, rows))  # Jc M^-1 Jc^T
+    for r in range(rows):
+        for c in range(rows):
+            total = 0.0
+            for k in range(n):
+                total += dyn[DYN_J + n * r + k] * mi_jt[k, c]
+            gram[r, c] = total
+    for r in range(rows):  # symmetric to the last bit, as its factor assumes
+        for c in range(r):
+            gram[r, c] = gram[c, r] = 0.5 * (gram[r, c] + gram[c, r])
+    gram_low = cholesky_k(gram, rows)
+    k_t = np.empty((rows, n))  # (Jc M^-1 Jc^T)^-1 Jc M^-1, i.e. the transpose of M^-1 Jc^T (Jc M^-1 Jc^T)^-1
+    for r in range(rows):
+        for i in range(n):
+            k_t[r, i] = mi_jt[i, r]
+    cholesky_solve_k(gram_low, k_t, rows)
+    p = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = mi[i, j]
+            for r in range(rows):
+                total -= mi_jt[i, r] * k_t[r, j]
+            p[i, j] = total
+    b = np.empty(n)
+    for i in range(n):
+        total = 0.0
+        for j in range(n):
+            total += p[i, j] * dyn[DYN_F + j]
+        b[i] = total
+    return p, b
 
 
 @njit
