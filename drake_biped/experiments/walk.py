@@ -31,6 +31,7 @@ from drake_biped.params import (
     Push,
     TorqueFreeWindow,
     check_settings,
+    check_window_given,
     walked_the_distance,
 )
 from drake_biped.records import warn, write_text_atomic
@@ -215,6 +216,27 @@ def long_run_lines(result) -> list[str]:
             f"{lr['step_period_mean_s']:.3f} ± {lr['step_period_std_s']:.3f} s)"]
 
 
+def record_comparison_lines(params, config: EpisodeConfig, result) -> list[str]:
+    """Where --params is a walk's record (a result.json: its "config" and its "cost_of_transport"), how this walk's
+    C_mt compares with the record's (versions.compare_with_record: to the last digit on the record's machine,
+    within a stated tolerance on another); none for a gait or a parameter file."""
+    from drake_biped.records import read_json
+    from drake_biped.resources import gait_path
+    from drake_biped.versions import compare_with_record
+
+    if params is None:
+        return []
+    path = gait_path(params)
+    record = read_json(path, "--params")
+    if not (isinstance(record, dict) and isinstance(record.get("config"), dict)
+            and isinstance(record.get("cost_of_transport"), (int, float))):
+        return []
+    if EpisodeConfig.from_dict(record["config"]).to_dict() != config.to_dict():
+        return [f"record {path}: not compared, this walk's configuration is not the record's (options changed it)"]
+    comparison = compare_with_record(record["cost_of_transport"], result.cost_of_transport, record.get("versions"))
+    return [f"record {path}: {comparison.text}"]
+
+
 def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_trajectory: bool = False,
                progress=None):
     """Walk one episode of `config` and write into `out`: result.json, diagram.svg/.png (when Graphviz is
@@ -284,9 +306,7 @@ def settings_from_args(args: argparse.Namespace) -> WalkSettings:
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
     if args.t1 is not None:
-        if args.t2 <= args.t1:
-            raise ParameterError(f"--t1 {args.t1:g} --t2 {args.t2:g}: t2 <= t1 is no torque-free window; "
-                                 "give t1 < t2, or neither to walk without one")
+        check_window_given(args.t1, args.t2, ("--t1", "--t2"))
         config = config.replace(window=TorqueFreeWindow(args.t1, args.t2))
     if args.push is not None:
         config = config.replace(push=Push(args.push, args.push_start, args.push_duration))
@@ -302,6 +322,7 @@ def command(args: argparse.Namespace) -> int:
     out = Path(args.out)
     result = run(settings, out)
     print_lines(summary_lines(result))
+    print_lines(record_comparison_lines(args.params, config, result))
     note = mass_note(result.mass_kg)
     if note is not None:
         print(note, file=sys.stderr)
