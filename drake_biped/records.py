@@ -182,12 +182,20 @@ def claim_folder(out: Path, command: str, settings: dict[str, Any], overwrite: b
 
     One process at a time: a second run into a folder held by another is refused, naming the holder. A folder
     holding another run's records (RUN_FILE names another command or other settings) is refused, naming both,
-    unless `overwrite`, which empties it first; the same command with the same settings continues (a resume),
-    and so does one whose `growable` settings (counts: episodes, trials, generations) are larger: a run is
-    extended, never shortened. A folder of records written without RUN_FILE is taken over as it is.
-    ParameterError naming `option`."""
+    unless `overwrite`; the same command with the same settings continues (a resume), and so does one whose
+    `growable` settings (counts: episodes, trials, generations) are larger: a run is extended, never shortened.
+
+    A run deletes only what the toolkit wrote. RUN_FILE lists the files and folders the folder's runs wrote
+    ("files": whatever appeared while a run held the folder, found by listing it, so that nothing a run writes
+    is missed, in subfolders or by any writer) and those they found there ("others"). `overwrite` deletes the
+    listed files (and the listed folders left empty), never the others, and the run goes on beside them. A
+    folder holding files without a RUN_FILE is refused, naming them, unless `overwrite`: then the run writes
+    beside them (a file of the same name as one it writes is replaced) and takes over records it finds there,
+    as a resume. A RUN_FILE written before runs listed their files (no "files") still resumes, and keeps no
+    list; another run's `overwrite` there is refused, naming the files, since none can be shown to be the
+    toolkit's. A file put into the folder while a run holds it, or after a killed run before its resume,
+    counts as the run's. ParameterError naming `option`."""
     import fcntl
-    import shutil
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -201,7 +209,6 @@ def claim_folder(out: Path, command: str, settings: dict[str, Any], overwrite: b
         lock.close()
         raise ParameterError(f"{option} {out}: another run is writing this folder ({holder}); wait for it to end, "
                              "or choose another folder") from None
-    fresh = False
     try:
         lock.seek(0)
         lock.truncate()
@@ -209,39 +216,162 @@ def claim_folder(out: Path, command: str, settings: dict[str, Any], overwrite: b
         lock.flush()
         header = out / RUN_FILE
         this = {"command": command, "settings": settings}
-        if header.is_file():
-            try:
-                before = json.loads(header.read_text())
-            except (OSError, ValueError):
-                before = None
+        before = _read_run_file(header)
+        present = _listing(out)
+        new_claim = before is None
+        if before is None:  # no run's folder: empty, or files of unknown origin
+            others = present
+            if others and not overwrite:
+                raise ParameterError(f"{option} {out} holds files no drake-biped run listed as its own (no {RUN_FILE}"
+                                     f"): {_named(others)}; choose another folder, or give --overwrite to write "
+                                     "beside them (they are kept; one of the same name as a file this run writes "
+                                     "is replaced)")
+            if others:
+                warn(f"{option} {out}: writing beside files no drake-biped run listed as its own, which are kept "
+                     f"as they are: {_named(others)}")
+        else:
             shorter = _shortened(before, this, growable)
             if shorter and not overwrite:
                 raise ParameterError(f"{option} {out} holds a longer run of the same command ({shorter}): a run is "
                                      "extended, never shortened; give the larger count, choose another folder, "
                                      "or give --overwrite to replace its records")
-            if not _same_run(before, this, growable):
-                if not overwrite:
-                    raise ParameterError(f"{option} {out} holds the records of another run ({_difference(before, this)}"
-                                         "): rerun that command to resume it, choose another folder, or give "
-                                         "--overwrite to replace its records")
-                for entry in out.iterdir():
-                    if entry.name != LOCK_FILE:
-                        shutil.rmtree(entry) if entry.is_dir() and not entry.is_symlink() else entry.unlink()
-                fresh = True
-        else:
-            fresh = not any(p.name not in (LOCK_FILE, ".drake-biped-write-test") for p in out.iterdir())
-        created = not header.is_file() or fresh
-        write_text_atomic(header, json.dumps(this, indent=1, sort_keys=True) + "\n")
+            replace = shorter or not _same_run(before, this, growable)
+            if replace and not overwrite:
+                raise ParameterError(f"{option} {out} holds the records of another run ({_difference(before, this)}"
+                                     "): rerun that command to resume it, choose another folder, or give "
+                                     "--overwrite to replace its records")
+            listed = _listed(before) if present else (set(), set())
+            if listed is None:  # written before runs listed their files: none can be shown to be the toolkit's
+                if replace:
+                    raise ParameterError(f"{option} {out} holds the records of another run whose {RUN_FILE} lists "
+                                         "no files (an older drake-biped's, or unreadable), so --overwrite cannot "
+                                         f"tell them from files of your own: {_named(present)}; move or delete them, "
+                                         "or choose another folder")
+                others = None
+            else:
+                files, others = listed
+                if before.get("writing"):  # that run was stopped before it listed what it wrote
+                    files = present - others
+                files &= present
+                others = present - files
+                if replace:
+                    _delete_listed(out, files)
+                    others = _listing(out)
+                    if others:
+                        warn(f"{option} {out}: the records of the run replaced are deleted; files no drake-biped "
+                             f"run listed as its own are kept as they are: {_named(others)}")
+            new_claim = replace
+        _write_run_file(out, this, others, writing=True)
         try:
             yield
         except BaseException:
-            if created:  # a run refused or failed in a folder it began: the folder keeps no claim of it
+            if others is not None and new_claim and not _listing(out) - others:
+                # a run refused or failed in a folder it began, having written nothing: the folder keeps no claim
                 header.unlink(missing_ok=True)
+            else:
+                _write_run_file(out, this, others, writing=False)
             raise
+        _write_run_file(out, this, others, writing=False)
     finally:
         lock_path.unlink(missing_ok=True)
         fcntl.flock(lock, fcntl.LOCK_UN)
         lock.close()
+
+
+# Files of the toolkit's own bookkeeping, at the top of an output folder: never listed, never deleted.
+_BOOKKEEPING = (LOCK_FILE, RUN_FILE, RUN_FILE + ".tmp", ".drake-biped-write-test")
+
+
+def _listing(out: Path) -> set[str]:
+    """Everything in `out` (its own bookkeeping aside) as paths relative to it, a folder's ending in "/";
+    links are not followed."""
+    found: set[str] = set()
+
+    def walk(folder: Path, prefix: str) -> None:
+        with os.scandir(folder) as entries:
+            for entry in entries:
+                name = prefix + entry.name
+                if not prefix and entry.name in _BOOKKEEPING:
+                    continue
+                if entry.is_dir(follow_symlinks=False):
+                    found.add(name + "/")
+                    walk(Path(entry.path), name + "/")
+                else:
+                    found.add(name)
+
+    walk(Path(out), "")
+    return found
+
+
+def _named(paths: set[str], most: int = 5) -> str:
+    """`paths` for a one-line message: a folder holding more than one of them stands for them; the first
+    `most`, then a count."""
+    shown: list[str] = []
+
+    def visit(prefix: str) -> None:
+        inside = [p for p in paths if p.startswith(prefix) and p != prefix]
+        children = sorted({prefix + p[len(prefix):].split("/")[0] + ("/" if "/" in p[len(prefix):] else "")
+                           for p in inside})
+        for child in children:
+            if not child.endswith("/"):
+                shown.append(child)
+                continue
+            files = [p for p in paths if p.startswith(child) and not p.endswith("/")]
+            if len(files) == 1:
+                visit(child)
+            else:  # several files, or an empty folder
+                shown.append(child)
+
+    visit("")
+    return ", ".join(shown[:most]) + (f" and {len(shown) - most} more" if len(shown) > most else "")
+
+
+def _read_run_file(header: Path) -> Any:
+    """The JSON of RUN_FILE; None when there is none; {} when it does not read (it names no run)."""
+    if not header.is_file():
+        return None
+    try:
+        before = json.loads(header.read_text())
+    except (OSError, ValueError):
+        return {}
+    return before if isinstance(before, dict) else {}
+
+
+def _listed(before: dict[str, Any]) -> tuple[set[str], set[str]] | None:
+    """RUN_FILE's lists (files the runs wrote, others found there); None when it holds none (an older run's, or
+    an unreadable one)."""
+    files, others = before.get("files"), before.get("others")
+    if not (isinstance(files, list) and isinstance(others, list)
+            and all(isinstance(p, str) for p in files + others)):
+        return None
+    return set(files), set(others)
+
+
+def _write_run_file(out: Path, this: dict[str, Any], others: set[str] | None, writing: bool) -> None:
+    """out/RUN_FILE: the run's command and settings, and, where `others` is known, what the folder holds now
+    split into the files the runs wrote (all but `others`) and the others. "writing" while the run holds the
+    folder: left in place when the run is killed, so that its resume counts what appeared since as the run's."""
+    record: dict[str, Any] = {"command": this["command"],
+                              "settings": json.loads(json.dumps(this["settings"], sort_keys=True))}
+    if others is not None:
+        present = _listing(out)
+        if writing:
+            record["writing"] = True
+        record["files"] = sorted(present - others)
+        record["others"] = sorted(others & present)
+    write_text_atomic(out / RUN_FILE, json.dumps(record, indent=1) + "\n")
+
+
+def _delete_listed(out: Path, files: set[str]) -> None:
+    """Delete the files listed in `files`, then the listed folders left empty (the deepest first)."""
+    for name in files:
+        if not name.endswith("/"):
+            (out / name).unlink(missing_ok=True)
+    for name in sorted((n for n in files if n.endswith("/")), key=lambda n: n.count("/"), reverse=True):
+        try:
+            (out / name).rmdir()
+        except OSError:  # holds a file of the user's: kept
+            pass
 
 
 def _same_run(before: Any, this: dict[str, Any], growable: tuple[str, ...]) -> bool:

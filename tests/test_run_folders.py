@@ -19,7 +19,8 @@ def test_a_folder_is_held_by_one_run_and_refused_to_another_naming_both(tmp_path
         with pytest.raises(ParameterError, match=r"another run is writing this folder \(process \d+: drake-biped walk"):
             with claim_folder(out, "walk", {"t1": 0.3}):
                 pass
-    assert json.loads((out / RUN_FILE).read_text()) == {"command": "walk", "settings": {"t1": 0.3}}
+    assert json.loads((out / RUN_FILE).read_text()) == {"command": "walk", "settings": {"t1": 0.3},
+                                                        "files": ["result.json"], "others": []}
     assert not (out / LOCK_FILE).exists() or (out / LOCK_FILE).read_text()
     with claim_folder(out, "walk", {"t1": 0.3}):  # the same run again: a resume
         pass
