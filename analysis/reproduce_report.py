@@ -19,7 +19,7 @@ from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.floquet import record_verdict
-from drake_biped.analysis.rewalks import window_acted
+from drake_biped.analysis.rewalks import saving_spread, window_acted
 from drake_biped.analysis.series import cmt_change, signed_percent
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
@@ -109,8 +109,10 @@ def reduction_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
     rewalked = evaluation.get("rewalks")
     if rewalked:
         reduction = rewalked["mean_saving"]
+        spread = saving_spread(rewalked)
+        spread = f"{spread} over trials" if spread.startswith("±") else spread.strip("()")
         ours = (f"C_mt {cmt_change(reduction)} re-walked at half the step and from "
-                f"0.95 / 1.05 × the initiation speed (± {100 * rewalked['std_saving']:.1f} % over trials; "
+                f"0.95 / 1.05 × the initiation speed ({spread}; "
                 f"{rewalked['holding']} of {trials} trials save ≥ {100 * rewalked['hold_saving']:.0f} % in every "
                 f"walk); as learned {cmt_change(as_learned)}, {walks} of {trials} walk, "
                 f"{windows} end with a window")
@@ -421,7 +423,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "Using CPG-Based Reinforcement Learning*. Every claim is measured on one gait, "
         + ("the default" if gait == "default" else f"`{gait}`") + " (its "
         f"plant step {_ms(s['learn']['settings']['config'])}), with one torque-free window: {wtext}, {source}. Each row "
-        "links to its section; every number below is measured by this run, in the folder named in its section."
+        f"links to its section, each number in the folder named there. {provenance_text(s)}"
         + (f" What this gait's story chooses where the paper prints nothing: {choices}." if choices else ""),
         "",
         "| what | paper | ours | verdict |",
@@ -694,6 +696,24 @@ def full_run_digest(out: Path, verdicts: list[tuple[str, str, str, str]], profil
             "code": checks[next(iter(CHECKED_SOURCES))]["versions"], "rows": claim_rows(verdicts), "checks": checks}
 
 
+def provenance_text(s: dict[str, dict[str, Any]]) -> str:
+    """Which steps this run measured and which it reused from the records already in its folder (a resumed or
+    copied folder), each reused one with the code that measured it, as its summary records it."""
+    reused = [name for name, x in s.items() if x.get("reused")]
+    if not reused:
+        return "Every number below is measured by this run."
+    by: dict[str, list[str]] = {}
+    for name in reused:
+        code = s[name].get("measured_by")
+        key = (f"drake-biped {code.get('drake_biped')} ({code.get('git_commit')}), Drake {code.get('drake')}"
+               if code else "code not recorded")
+        by.setdefault(key, []).append(name)
+    measured = [name for name in s if name not in reused]
+    return (f"Measured by this run: {', '.join(measured) or 'none'}. Reused from the records already in this "
+            "folder, not measured again: " + "; ".join(f"{', '.join(names)} (measured by {key})"
+                                                        for key, names in by.items()) + ".")
+
+
 def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Any,
                  code: dict[str, Any], full_run: dict[str, Any] | None = None, gait: str = "default",
                  choices: str = "") -> list[Path]:
@@ -773,11 +793,12 @@ def full_run_gait_name(full_run: dict[str, Any] | None) -> str | None:
     configs = [c["config"] for c in (full_run or {}).get("checks", {}).values() if "config" in c]
     if not configs:
         return None
-    sections = ("cpg", "gait", "initial")
-    same = lambda a, b: all(a.get(k) == b.get(k) for k in sections)  # noqa: E731
-    recorded = config_of_record(configs[0]).to_dict()  # a record older than a field reads its default
+    def walked(config):  # what the controller reads: a field the gait's readings leave unread is no difference
+        return config.cpg, config.gait.as_walked(), config.initial
+
+    recorded = walked(config_of_record(configs[0]))  # a record older than a field reads its default
     for name in sorted(gait_names(), key=lambda n: n != "default"):
-        if same(recorded, load_gait(name).to_dict()):
+        if recorded == walked(load_gait(name)):
             return name
     return None
 
@@ -810,7 +831,7 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         "to judge most of the paper's claims (learning needs hundreds of episodes, a stability cell several "
         "trials): where it cannot, its column says so, and the full run's verdict stands beside it, "
         f"from the records shipped with the package (full run: drake-biped {full_code.get('git_commit')}, "
-        f"Drake {full_code.get('drake')})."
+        f"Drake {full_code.get('drake')}). {provenance_text(s)}"
         + (" The full run's learned windows, and no window, were walked again here: where they give the C_mt the "
            "full run recorded, its row says so (✓)." if fr else ""),
         "",

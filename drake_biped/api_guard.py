@@ -16,15 +16,19 @@ from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from typing import Any, TypeVar
 
-from drake_biped.params import EpisodeConfig, Ground, ParameterError
+from drake_biped.params import EpisodeConfig, Ground, ParameterError, SimulationParams, check_declared
 
 __all__ = ["DrakeFailure", "api_function", "check_argument", "drake_failure_message", "drake_failures_raised",
            "is_drake_failure"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-# The arguments, by name, that the API's Drake functions take as configuration, and their types.
-ARGUMENT_TYPES: dict[str, type] = {"config": EpisodeConfig, "ground": Ground}
+# The arguments, by name, that the API's Drake functions take as configuration, and their types; a flag is a
+# bool, never a string or a number that reads as one ("no" is true).
+ARGUMENT_TYPES: dict[str, type] = {"config": EpisodeConfig, "ground": Ground, "record": bool,
+                                   "record_trajectory": bool}
+# The numbers they take that an EpisodeConfig declares: checked against that one declaration (`params.param`).
+DECLARED_ARGUMENTS: dict[str, tuple[type, str]] = {"time_step_s": (SimulationParams, "time_step_s")}
 
 
 class DrakeFailure(RuntimeError):
@@ -59,7 +63,10 @@ def drake_failures_raised(what: str) -> Iterator[None]:
 
 def check_argument(function: str, name: str, value: Any, optional: bool) -> None:
     """ParameterError naming `function`, the argument and its value unless `value` is of the type
-    ARGUMENT_TYPES[name] (or None, when `optional`)."""
+    ARGUMENT_TYPES[name] (or None, when `optional`), or within its declaration (DECLARED_ARGUMENTS)."""
+    if name in DECLARED_ARGUMENTS:
+        check_declared(*DECLARED_ARGUMENTS[name], value, function)
+        return
     cls = ARGUMENT_TYPES[name]
     if isinstance(value, cls) or (optional and value is None):
         return
@@ -73,7 +80,8 @@ def api_function(fn: F) -> F:
     """`fn` as the API hands it out: its configuration arguments (ARGUMENT_TYPES) checked by name, and
     pydrake's SystemExit for a failed check raised as DrakeFailure naming `fn`."""
     signature = inspect.signature(fn)
-    checked = {name: p.default is None for name, p in signature.parameters.items() if name in ARGUMENT_TYPES}
+    checked = {name: p.default is None for name, p in signature.parameters.items()
+               if name in ARGUMENT_TYPES or name in DECLARED_ARGUMENTS}
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:

@@ -396,6 +396,9 @@ def run_episode(
                              f"{cache!r}")
     if kick is not None and not isinstance(kick, Kick):
         raise ParameterError(f"run_episode: kick must be a Kick or None, got {type(kick).__name__}")
+    if not isinstance(record_trajectory, bool):  # "no" would record
+        raise ParameterError(f"run_episode: record_trajectory must be a bool, got {type(record_trajectory).__name__} "
+                             f"{record_trajectory!r:.60}")
     if record_trajectory or meshcat is not None:
         check_record_memory(config)
     parts, simulator, reason, wall = simulate(

@@ -24,7 +24,8 @@ from drake_biped.paper import (
 __all__ = [
     "ContactParams", "CpgParams", "param", "parameter_info", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
-    "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
+    "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "check_declared",
+    "check_given", "check_window_given", "config_of_params", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "CYCLE_INITIAL", "LEARNED_WINDOW_S", "RobotModel",
 ]
 
@@ -79,6 +80,54 @@ def parameter_info(cls: type, name: str) -> dict[str, Any]:
     raise KeyError(f"{cls.__name__} has no field {name!r}")
 
 
+def _declared_value(owner: str, f: dataclasses.Field, value: Any) -> Any:
+    """`value` checked against the field `f`'s declaration (its type, and `param`'s bounds or finiteness; an int
+    given for a float comes back a float); ParameterError naming `owner`.`f.name` and the value otherwise."""
+    kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+    optional = kind.endswith("| None")
+    kind = kind.removesuffix("| None").strip()
+    if value is None and optional:
+        return value
+    if kind == "float":
+        if not _is_number(value):
+            raise ParameterError(f"{owner}.{f.name} must be a number, got {_shown(value)}")
+        value = float(value)
+    elif kind == "int":
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise ParameterError(f"{owner}.{f.name} must be an integer, got {_shown(value)}")
+    elif kind == "str":
+        if not isinstance(value, str):
+            raise ParameterError(f"{owner}.{f.name} must be a string, got {_shown(value)}")
+    elif kind in _SECTION_CLASSES and not isinstance(value, _SECTION_CLASSES[kind]):
+        hint = f"; build it with {kind}(...) or {kind}.from_dict(...)" if isinstance(value, dict) else ""
+        raise ParameterError(f"{owner}.{f.name} must be a {kind}, got {type(value).__name__} {_shown(value)}{hint}")
+    bounds = f.metadata.get("bounds")
+    if bounds is not None and _is_number(value):
+        _check_range(owner, f.name, value, *bounds)
+    elif isinstance(value, float):
+        _check_finite(owner, f.name, value)
+    return value
+
+
+def _shown(value: Any) -> str:
+    """`value` for a one-line message: its repr, cut to 60 characters."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def check_declared(cls: type, name: str, value: Any, where: str) -> Any:
+    """`value` checked against the declaration of `cls`'s field `name` (`param`: its type and bounds), for a
+    value that enters elsewhere than through the dataclass (a function's argument); ParameterError naming
+    `where` otherwise. Returns the value (an int given for a float as a float)."""
+    for f in fields(cls):
+        if f.name == name:
+            try:
+                return _declared_value(cls.__name__, f, value)
+            except ParameterError as exc:
+                raise ParameterError(f"{where}: {exc}") from None
+    raise KeyError(f"{cls.__name__} has no field {name!r}")
+
+
 class _Validated:
     """Mixin: every field is checked against its declared type after init (an int given for a float is
     stored as a float), and every number against its declared bounds (`param`) or for being finite."""
@@ -86,33 +135,9 @@ class _Validated:
     def __post_init__(self) -> None:
         owner = type(self).__name__
         for f in fields(self):
-            value = getattr(self, f.name)
-            kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
-            optional = kind.endswith("| None")
-            kind = kind.removesuffix("| None").strip()
-            if value is None and optional:
-                continue
-            if kind == "float":
-                if not _is_number(value):
-                    raise ParameterError(f"{owner}.{f.name} must be a number, got {value!r}")
-                value = float(value)
+            value = _declared_value(owner, f, getattr(self, f.name))
+            if value is not getattr(self, f.name):
                 object.__setattr__(self, f.name, value)
-            elif kind == "int":
-                if not isinstance(value, int) or isinstance(value, bool):
-                    raise ParameterError(f"{owner}.{f.name} must be an integer, got {value!r}")
-            elif kind == "str":
-                if not isinstance(value, str):
-                    raise ParameterError(f"{owner}.{f.name} must be a string, got {value!r}")
-            elif kind in _SECTION_CLASSES and not isinstance(value, _SECTION_CLASSES[kind]):
-                hint = (f"; build it with {kind}(...) or {kind}.from_dict(...)" if isinstance(value, dict)
-                        else "")
-                raise ParameterError(f"{owner}.{f.name} must be a {kind}, got {type(value).__name__} "
-                                     f"{value!r}{hint}")
-            bounds = f.metadata.get("bounds")
-            if bounds is not None and _is_number(value):
-                _check_range(owner, f.name, value, *bounds)
-            elif isinstance(value, float):
-                _check_finite(owner, f.name, value)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -131,6 +156,7 @@ class _Validated:
         data = dict(data)
         if cls is EpisodeConfig:
             data.pop("about", None)  # a shipped gait file's reasons (drake_biped/gaits/): text, not a parameter
+            data.pop("compare_window", None)  # the window a gait file is compared with (resources.gait_compare_window)
         known = {f.name: f for f in fields(cls)}
         unknown = sorted(set(data) - set(known))
         if unknown:
@@ -617,7 +643,7 @@ class EpisodeConfig(_Validated):
     push: Push | None = None
     sim: SimulationParams = field(default_factory=SimulationParams)
     contact: ContactParams = field(default_factory=ContactParams)
-    seed: int = param(0, "1", "recorded with the result (the episode itself is deterministic)")
+    seed: int = param(0, "1", "recorded with the result (the episode itself is deterministic)", 0, None)
     # The robot: None for the shipped model (models/biped.urdf, Table I), else a user's model file.
     model: RobotModel | None = None
 
@@ -630,8 +656,6 @@ class EpisodeConfig(_Validated):
             raise ParameterError(f"EpisodeConfig.model must be a model file's path or a RobotModel, got "
                                  f"{type(self.model).__name__}")
         super().__post_init__()
-        if self.seed < 0:
-            raise ParameterError(f"EpisodeConfig.seed must be a non-negative integer, got {self.seed!r}")
         if self.push is not None and self.push.force_n != 0.0 and self.push.duration_s == 0.0:
             raise ParameterError(f"Push.duration_s = 0.0 with force_n {self.push.force_n!r}: the push would never "
                                  "act; give a duration, or no push")
@@ -664,16 +688,22 @@ class EpisodeConfig(_Validated):
         """A copy with whole sections (or the seed) replaced: `config.replace(window=TorqueFreeWindow(0.2, 0.5))`."""
         return dataclasses.replace(self, **changes)
 
-    def override(self, values: Mapping[str, Any]) -> EpisodeConfig:
+    def override(self, values: Mapping[str, Any], sampled: bool = False) -> EpisodeConfig:
         """A copy with single fields changed, named `section.field` (`"cpg.u_a"`, `"gait.torso_pitch_rad"`,
         `"sim.distance_m"`) or by a short name of `SHORT_NAMES` (`"u_a"`, `"kappa"`, `"t1"`, ...): the
-        names the grid specs use. Applied in order; each section is validated once it is rebuilt.
+        names the grid specs use. Applied in order; each section is validated once it is rebuilt, and the
+        values given are held to the rules that join fields (`check_given`: a window that never opens, a field
+        the gait leaves unread), unless `sampled`: the points a sweep or a search sets one by one, where
+        t2 <= t1 is the paper's "no window" for that point and an unread gain is walked as the gait reads it.
         `EpisodeConfig().override({"u_a": 1.8, "window.end_s": 0.5})`"""
         if not isinstance(values, Mapping):
             shown = repr(values) if len(repr(values)) <= 60 else repr(values)[:57] + "..."
             raise ParameterError(f"EpisodeConfig.override: values must be a mapping of field names to values "
                                  f"({{'u_a': 1.8}}), got {type(values).__name__} {shown}")
+        if not isinstance(sampled, bool):
+            raise ParameterError(f"EpisodeConfig.override: sampled must be a bool, got {_shown(sampled)}")
         sections: dict[str, dict[str, Any]] = {}
+        given: dict[str, str] = {}
         seed = self.seed
         for name, value in values.items():
             if name == "seed":  # the one field outside the sections
@@ -684,7 +714,11 @@ class EpisodeConfig(_Validated):
                 current = getattr(self, section)
                 sections[section] = (current or _SECTIONS[section]()).to_dict()
             sections[section][attr] = value
-        return self.replace(seed=seed, **{k: _SECTIONS[k].from_dict(v) for k, v in sections.items()})
+            given[f"{section}.{attr}"] = str(name)
+        config = self.replace(seed=seed, **{k: _SECTIONS[k].from_dict(v) for k, v in sections.items()})
+        if not sampled:
+            check_given(config, given, "EpisodeConfig.override")
+        return config
 
 
 def check_settings(settings: Any, cls: type, where: str) -> None:
@@ -692,6 +726,80 @@ def check_settings(settings: Any, cls: type, where: str) -> None:
     dataclass, never a mapping or a path)."""
     if not isinstance(settings, cls):
         raise ParameterError(f"{where}: settings must be a {cls.__name__}, got {type(settings).__name__}")
+
+
+def _named(name: str, value: float) -> str:
+    """How a message shows a value by the name the user gave it: "--t1 0.5" for an option, "t1 = 0.5" else."""
+    return f"{name} {value:g}" if name.startswith("--") else f"{name} = {value!r}"
+
+
+def check_window_given(start_s: float, end_s: float, names: tuple[str, str] = ("window.start_s", "window.end_s"),
+                       given: tuple[bool, bool] = (True, True), where: str = "") -> None:
+    """The torque-free window's rule where a user gives t1 or t2 (a params file, `override`, --t1/--t2): a
+    window that never opens (t2 <= t1) is refused, except 0 and 0, the explicit "no window"; ParameterError,
+    one line naming `where` and the fields as the user named them (`names`: t1's, t2's). `given`: whether t1,
+    t2 were given (the other kept its value). Learners sample windows with t2 <= t1 (the paper reads one as
+    no window for that episode) and records hold them: they enter through `TorqueFreeWindow(...)`,
+    `from_dict` or `override(..., sampled=True)`, which check each field alone."""
+    if end_s > start_s or (start_s == 0.0 and end_s == 0.0):
+        return
+    prefix = f"{where}: " if where else ""
+    t1, t2 = names
+    if given[0] and not given[1]:
+        raise ParameterError(f"{prefix}{_named(t1, start_s)} without {t2}: the window would end at {end_s:g} s, "
+                             f"before it starts, and never open; give {t2} > {start_s:g} too")
+    both = f"{_named(t1, start_s)}{' ' if t1.startswith('--') else ', '}{_named(t2, end_s)}"
+    raise ParameterError(f"{prefix}{both}: t2 <= t1 is no torque-free window, one that never opens; give t1 < t2, "
+                         "or 0 and 0 (or neither) for no window")
+
+
+def check_given(config: EpisodeConfig, given: Mapping[str, str], where: str) -> None:
+    """The rules that join fields, in one place, applied where a user gives values: a params file
+    (`resources.load_gait`), `EpisodeConfig.override`, a command's --t1/--t2. `given`: each field the user set
+    ("section.field") and the name the user wrote it by ("t1", "gait.hip_kp"). ParameterError, one line naming
+    `where` and the field, for
+    - a torque-free window that never opens (`check_window_given`), when t1 or t2 was given;
+    - a gait field that the gait's readings leave unread (`GaitParams.unread`: the servo's gains under the hip
+      motor, the motor's limit under the servo, the touchdown's phase threshold under the entrained phase)
+      given another value than its default: it would change no walk.
+    The per-field checks (type, bounds) are the dataclasses' own, made wherever a value enters."""
+    window = config.window
+    ends = ("window.start_s", "window.end_s")
+    if any(n in given for n in ends):
+        shorts = ("t1", "t2") if any(given.get(n) in ("t1", "t2") for n in ends) else ends
+        names = (given.get(ends[0], shorts[0]), given.get(ends[1], shorts[1]))
+        check_window_given(window.start_s, window.end_s, names, (ends[0] in given, ends[1] in given), where)
+    gait = config.gait
+    defaults = {f.name: f.default for f in fields(GaitParams)}
+    unread = gait.unread()
+    for dotted, name in given.items():
+        section, _, attr = dotted.partition(".")
+        if section != "gait" or attr not in unread or getattr(gait, attr) == defaults[attr]:
+            continue
+        if attr in gait.UNREAD_BY_ENTRAINED and gait.phase_reading == "entrained":
+            reading, other = f"phase_reading {gait.phase_reading!r}", "phase_reading 'reset'"
+        else:
+            reading = f"hip_drive {gait.hip_drive!r}"
+            other = "hip_drive 'motor'" if gait.hip_drive == "servo" else "hip_drive 'servo'"
+        raise ParameterError(f"{where}: {name} = {getattr(gait, attr)!r} is unread under {reading} "
+                             f"(GaitParams.unread), so it changes no walk; leave it out (its default is "
+                             f"{defaults[attr]!r}), or give {other}")
+
+
+def config_of_params(data: Any, where: str) -> EpisodeConfig:
+    """The EpisodeConfig of a params file's fields (`EpisodeConfig.from_dict`: each field checked against its
+    declaration), the fields the file sets held to the rules that join fields (`check_given`). A configuration
+    a run wrote (`EpisodeConfig.to_dict`, whose "sim" names the controller's clock: a grid's best_params.json,
+    a gait search's best_config.json) is read as a record is: its window may be a sampled point, its gait a
+    search's. A shipped gait is held to the same rules as a user's file."""
+    config = EpisodeConfig.from_dict(data, where)
+    if isinstance(data, Mapping) and isinstance(data.get("sim"), Mapping) and "controller_clock" in data["sim"]:
+        return config
+    given = {f"{section}.{name}": f"{section}.{name}"
+             for section, values in (data.items() if isinstance(data, Mapping) else ())
+             if section in _SECTIONS and isinstance(values, Mapping) for name in values}
+    check_given(config, given, where)
+    return config
 
 
 def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:

@@ -12,9 +12,9 @@ import os
 from importlib import resources
 from pathlib import Path
 
-from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.params import EpisodeConfig, ParameterError, config_of_params
 
-__all__ = ["full_run_digest", "gait_about", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
+__all__ = ["full_run_digest", "gait_about", "gait_compare_window", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
            "shipped_model_file"]
 
 
@@ -72,6 +72,29 @@ def gait_about(name: str) -> str:
     return str(json.loads(gait_path(name).read_text()).get("about", ""))
 
 
+def gait_compare_window(value: str | Path) -> tuple[tuple[float, float], str] | None:
+    """The torque-free window (t1, t2) in s that a gait file declares for the commands that compare a window
+    with none (stability, push-margin, ...), and where it comes from: its optional `compare_window`
+    {"start_s", "end_s", "source"}; None where the file declares none. ParameterError naming the file and the
+    field for a malformed one."""
+    from drake_biped.records import read_json
+
+    path = gait_path(value)
+    data = read_json(path, "--params")
+    declared = data.get("compare_window") if isinstance(data, dict) else None
+    if declared is None:
+        return None
+    where = f"--params {path}: compare_window"
+    if not isinstance(declared, dict) or set(declared) != {"start_s", "end_s", "source"}:
+        raise ParameterError(f"{where} {declared!r}: expected {{\"start_s\", \"end_s\", \"source\"}}")
+    t1, t2, source = declared["start_s"], declared["end_s"], declared["source"]
+    if not all(isinstance(t, (int, float)) and not isinstance(t, bool) for t in (t1, t2)) or not 0 <= t1 < t2:
+        raise ParameterError(f"{where}: start_s {t1!r}, end_s {t2!r}: need 0 <= start_s < end_s (s)")
+    if not isinstance(source, str) or not source.strip():
+        raise ParameterError(f"{where}: source {source!r}: say where the window comes from")
+    return (float(t1), float(t2)), source
+
+
 def gait_path(value: str | Path) -> Path:
     """A shipped gait by name (`climbing`, `climbing_2deg`, ...) or a parameter file by path."""
     return _named_or_path(value, "gaits", ".json", gait_names(), "--params")
@@ -85,16 +108,22 @@ def grid_spec_path(value: str | Path) -> Path:
 def load_gait(value: str | Path) -> EpisodeConfig:
     """The EpisodeConfig of a shipped gait (by name) or of a parameter file: EpisodeConfig fields as JSON,
     or a result record (a walk's result.json, a grid's best_params.json), whose "config" is used. Its "model"
-    is a model file's path (relative to the parameter file) or a record of one (its name, SHA-256 and text)."""
+    is a model file's path (relative to the parameter file) or a record of one (its name, SHA-256 and text).
+    A parameter file's fields are held to the rules that join fields (`params.config_of_params`); a record's
+    configuration is read as it was written."""
     from drake_biped.records import read_json
 
     path = gait_path(value)
     data = read_json(path, "--params")
-    if isinstance(data, dict) and "config" in data:
+    record = isinstance(data, dict) and "config" in data
+    if record:
         data = data["config"]
     if isinstance(data, dict):
-        data = {k: v for k, v in data.items() if k != "about"}  # a gait file's reasons, not a parameter
+        # a gait file's reasons and the window it is compared with: not parameters of its walk
+        data = {k: v for k, v in data.items() if k not in ("about", "compare_window")}
     if isinstance(data, dict) and isinstance(data.get("model"), str):
         # a model file named in a parameter file: a relative path is relative to the parameter file
         data = {**data, "model": str(Path(path).parent / data["model"])}
-    return EpisodeConfig.from_dict(data, f"--params {path}")
+    if record:  # written by a run: its window may be a learner's sample, its gait any reading's full record
+        return EpisodeConfig.from_dict(data, f"--params {path}")
+    return config_of_params(data, f"--params {path}")

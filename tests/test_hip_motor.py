@@ -139,14 +139,14 @@ def test_the_fields_a_reading_leaves_unread_change_no_walk_and_a_grid_refuses_th
 
     base = walked(paper)
     unread = paper.override({"gait.hip_kp": 10.0, "gait.placement_gain": 2.0, "gait.swing_offset_rad": 0.3,
-                             "gait.swing_reading": "anchored"})
+                             "gait.swing_reading": "anchored"}, sampled=True)  # a user is told they are unread
     assert unread.as_walked() == paper.as_walked() and walked(unread) == base
     read = paper.override({"gait.motor_limit_nm": 0.5 * paper.gait.motor_limit_nm})
     assert read.as_walked() != paper.as_walked() and walked(read) != base
     # the entrained reading leaves the touchdown's phase threshold unread: the CPG runs free of the steps
     entrained = load_gait("paper_entrained").override({"sim.distance_m": 10.0, "sim.max_time_s": 2.0})
     assert "touchdown_min_phase" in entrained.gait.unread()
-    moved = entrained.override({"gait.touchdown_min_phase": 3.0})
+    moved = entrained.override({"gait.touchdown_min_phase": 3.0}, sampled=True)
     assert moved.as_walked() == entrained.as_walked() and walked(moved) == walked(entrained)
     reset = entrained.override({"gait.phase_reading": "reset"})  # where the phase is reset, it is read
     assert "touchdown_min_phase" not in reset.gait.unread()

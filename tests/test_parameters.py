@@ -6,10 +6,8 @@ import math
 from dataclasses import fields
 from pathlib import Path
 
-import pytest
-
 from drake_biped import controller as ctl
-from drake_biped.params import EpisodeConfig, ParameterError, parameter_info
+from drake_biped.params import EpisodeConfig, parameter_info
 
 
 def test_every_slot_has_a_doc_and_a_unit():
@@ -30,31 +28,14 @@ def test_copied_slots_carry_their_declaration_and_value():
         hi = lo + 2.0 if hi is None else hi
         changed.setdefault(section, {})[name] = lo + (hi - lo) * (0.13 + 0.017 * i)
     changed["window"]["end_s"] = changed["window"]["start_s"] + 0.1
-    config = config.override({f"{s}.{n}": v for s, d in changed.items() for n, v in d.items()})
+    # every slot moved at once, the unread ones too (the servo leaves the motor's limit unread): a sampled point
+    config = config.override({f"{s}.{n}": v for s, d in changed.items() for n, v in d.items()}, sampled=True)
     law = ctl.law_vector(config)
     for section, name, slot in ctl.LAW_COPIED:
         field = ctl.LAW.fields[ctl.LAW.offset(slot)]
         info = parameter_info(type(getattr(config, section)), name)
         assert field.unit == info["unit"] and field.bounds == info["bounds"] and info["doc"] in field.doc
         assert law[ctl.LAW.offset(slot)] == getattr(getattr(config, section), name), slot
-
-
-@pytest.mark.parametrize("section", ["cpg", "gait", "window", "ground", "sim", "initial"])
-def test_declared_bounds_are_enforced(section):
-    cls = type(getattr(EpisodeConfig(), section))
-    checked = 0
-    for f in fields(cls):
-        if "bounds" not in f.metadata:
-            continue
-        lo, hi = f.metadata["bounds"]
-        for bad in ((hi + 1.0) if hi is not None else None, (lo - 1.0) if lo is not None else None):
-            if bad is None:
-                continue
-            value = int(bad) if f.type in ("int", int) else float(bad)
-            with pytest.raises(ParameterError, match=f"{cls.__name__}.{f.name}"):
-                cls(**{f.name: value})
-            checked += 1
-    assert checked > 0
 
 
 def test_the_entrained_reading_drops_the_phase_condition():

@@ -7,7 +7,6 @@ import pytest
 
 from drake_biped.cli import main
 from drake_biped.params import (
-    CpgParams,
     EpisodeConfig,
     Ground,
     ParameterError,
@@ -21,11 +20,6 @@ def test_a_walk_has_walked_its_distance_only_to_it_and_without_a_fall():
     assert walked_the_distance(False, 10.0 - 1e-9, 10.0)  # distance = com_x - com_x0, rounded
     assert not walked_the_distance(False, 9.99, 10.0)
     assert not walked_the_distance(True, 10.5, 10.0)  # a fall, however far it went
-
-
-def test_nan_parameter_named():
-    with pytest.raises(ParameterError, match="u_r"):
-        CpgParams(u_r=math.nan)
 
 
 def test_out_of_range_parameter_named():

@@ -12,7 +12,14 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-from drake_biped.params import EpisodeConfig, ParameterError, with_time_step
+from drake_biped.params import (
+    EpisodeConfig,
+    ParameterError,
+    SimulationParams,
+    check_declared,
+    check_window_given,
+    with_time_step,
+)
 from drake_biped.resources import gait_names, load_gait
 
 # The sizes a run may be given, bounded before any work (`check_size`, `check_memory`). A run beyond a count
@@ -80,6 +87,27 @@ def check_reaches_touchdown(config: EpisodeConfig, touchdown: int, why: str) -> 
                              f"walk at least {math.ceil(need):g} m")
 
 
+def why_unchanged(config: EpisodeConfig, name: str, values) -> str:
+    """Why every value in `values` of the field `name`, set alone in `config`, walks the same episode
+    (`EpisodeConfig.as_walked`), in words for a refusal: the reason that holds, not a list of guesses."""
+    from drake_biped.params import resolve_field
+
+    section, attr = resolve_field(name)
+    configs = [config.override({name: float(v)}, sampled=True) for v in values]
+    if section == "gait" and attr in config.gait.unread():
+        g = config.gait
+        reading = (f"phase reading {g.phase_reading!r}" if attr in g.UNREAD_BY_ENTRAINED
+                   and g.phase_reading == "entrained" else f"hip drive {g.hip_drive!r}")
+        return f"gait.{attr} is unread under this gait's {reading} (GaitParams.unread): no walk reads it"
+    if section == "window" and not any(c.window.active for c in configs):
+        return "the torque-free window never opens at any value (t2 <= t1 at each): every walk is the one without"
+    if section == "ground" and attr == "level_length_m" and all(c.ground.slope_rad == 0.0 for c in configs):
+        return "a level stretch on level ground is no change of ground"
+    if section == "push" and all(c.as_walked().push is None for c in configs):
+        return "the push never acts (no force, no duration, or it starts after the walk's time limit)"
+    return "every value walks the same episode (EpisodeConfig.as_walked)"
+
+
 def number(kind: str):
     """An option's type: a finite number, and for `kind` "positive" > 0, "nonnegative" >= 0 ("finite": any);
     argparse reports a refusal as one line naming the option and the value."""
@@ -127,13 +155,23 @@ def out_folder(text: str) -> Path:
     new = [p for p in (path, *path.parents) if not p.exists()]
     MADE.extend(reversed(new))  # removed again, if still empty, when the command refuses its input
     try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / ".drake-biped-write-test"
+        check_writable(path, repr(text))
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return path
+
+
+def check_writable(folder: Path, what: str) -> None:
+    """ParameterError naming `what` (the option and the folder) unless `folder` exists or can be made, and a file can be written in it:
+    asked before any work by every command that writes (--out is checked so as it is parsed; a command that
+    writes elsewhere, beside a record it reads, asks this of that folder)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".drake-biped-write-test"
         probe.write_text("")
         probe.unlink()
     except OSError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: cannot write there ({exc.strerror or exc})") from None
-    return path
+        raise ParameterError(f"{what}: cannot write there ({exc.strerror or exc})") from None
 
 
 MADE: list[Path] = []  # folders --out made in this invocation
@@ -173,17 +211,29 @@ def add_clock_option(p: argparse.ArgumentParser) -> None:
 
 def with_clock(config: EpisodeConfig, time_step_s: float | None, control_period_s: float | None) -> EpisodeConfig:
     """`config` at the --time-step and with the --control-period given (None: kept), checked together and named
-    by option: a fixed-rate loop must be a whole multiple of the plant step."""
+    by option: a fixed-rate loop must be a whole multiple of the plant step; each value within its field's
+    declaration."""
     if control_period_s is not None:
+        check_declared(SimulationParams, "control_period_s", control_period_s, f"--control-period {control_period_s:g}")
         step = config.sim.time_step_s if time_step_s is None else time_step_s
         ratio = control_period_s / step
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
             raise ParameterError(f"--control-period {control_period_s!r}: not a whole multiple of the plant step "
                                  f"{step!r} s")
-        config = config.replace(sim=dataclasses.replace(config.sim, time_step_s=step,
-                                                        control_period_s=control_period_s))
+        try:
+            config = config.replace(sim=dataclasses.replace(config.sim, time_step_s=step,
+                                                            control_period_s=control_period_s))
+        except ParameterError as exc:
+            given = f"--control-period {control_period_s:g}" + ("" if time_step_s is None else
+                                                                f" --time-step {time_step_s:g}")
+            raise ParameterError(f"{given}: {exc}") from None
     if time_step_s is not None:
-        config = config.replace(sim=with_time_step(config.sim, time_step_s, "--time-step"))
+        try:
+            config = config.replace(sim=with_time_step(config.sim, time_step_s, "--time-step"))
+        except ParameterError as exc:
+            text = str(exc)
+            raise ParameterError(text if text.startswith("--time-step") else
+                                 f"--time-step {time_step_s:g}: {text}") from None
     return config
 
 
@@ -214,16 +264,25 @@ CONVERGED_TIME_STEP_S = 0.001
 def episode_config(args: argparse.Namespace) -> EpisodeConfig:
     config = EpisodeConfig() if args.params is None else load_gait(args.params)
     changes: dict[str, float] = {}
+    given: list[str] = []  # the options, as a refusal names them: each value is checked by its field's declaration
     if args.distance is not None:
         changes["sim.distance_m"] = args.distance
         changes["sim.max_time_s"] = max(config.sim.max_time_s, 6.0 * args.distance)
+        given.append(f"--distance {args.distance:g}")
     if args.max_time is not None:
         changes["sim.max_time_s"] = args.max_time
+        given.append(f"--max-time {args.max_time:g}")
     if args.slope is not None:
         changes["ground.slope_rad"] = args.slope
+        given.append(f"--slope {args.slope:g}")
     if args.level_length is not None:
         changes["ground.level_length_m"] = args.level_length
-    config = with_clock(config.override(changes), args.time_step, args.control_period)
+        given.append(f"--level-length {args.level_length:g}")
+    try:
+        config = config.override(changes)
+    except ParameterError as exc:
+        raise ParameterError(f"{' '.join(given)}: {exc}") from None
+    config = with_clock(config, args.time_step, args.control_period)
     config = with_model(config, args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
         print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
@@ -263,28 +322,49 @@ def policy_window(path: Path) -> tuple[float, float]:
     return max(0.0, float(row["t1"])), max(0.0, float(row["t2"]))
 
 
-def default_window(config: EpisodeConfig) -> tuple[float, float]:
-    """The window a command compares with none when none is given: the gait's own where it carries one, else
-    the default gait's learned window (params.LEARNED_WINDOW_S)."""
-    from drake_biped.params import LEARNED_WINDOW_S
+def default_window(config: EpisodeConfig, params: str | None = None) -> tuple[tuple[float, float], str]:
+    """The window a command compares with none when none is given, and where it comes from: the gait's own
+    where it carries one, else the one its gait file declares (`resources.gait_compare_window`; `params`: the
+    --params given, None for the default gait). ParameterError naming --params where the gait declares none:
+    another gait's window is no comparison for it, so the command needs --t1 and --t2 (or --policy)."""
+    from drake_biped.resources import gait_compare_window
 
     w = config.window
-    return (w.start_s, w.end_s) if w.active else LEARNED_WINDOW_S
+    if w.active:
+        return (w.start_s, w.end_s), "the gait's own window (its window section)"
+    name = "default" if params is None else params
+    declared = gait_compare_window(name)
+    if declared is None:
+        raise ParameterError(f"--params {name}: the gait declares no window to compare with none (its own never "
+                             "opens and its file has no compare_window); give one with --t1 and --t2, or --policy")
+    window, source = declared
+    return window, f"{source} (gait file {name})"
 
 
-def chosen_window(args: argparse.Namespace, config: EpisodeConfig | None = None) -> tuple[float, float]:
-    """The torque-free period to compare against none: --policy, or --t1/--t2, or `default_window(config)`."""
+def chosen_window_and_source(args: argparse.Namespace,
+                             config: EpisodeConfig | None = None) -> tuple[tuple[float, float], str]:
+    """The torque-free period to compare against none and where it comes from: --policy, or --t1/--t2, or
+    `default_window` of the gait (`config`, of --params)."""
     if args.policy is not None and args.t1 is not None:
         raise ParameterError("give either --policy or --t1/--t2, not both")
     if (args.t1 is None) != (args.t2 is None):
         raise ParameterError("--t1 and --t2 go together: give both or neither")
     if args.policy is not None:
-        return policy_window(Path(args.policy))
+        return policy_window(Path(args.policy)), f"--policy {args.policy} (its best learned trial)"
     if args.t1 is not None:
-        if args.t2 <= args.t1:
-            raise ParameterError(f"--t1 {args.t1} --t2 {args.t2}: need t1 < t2")
-        return args.t1, args.t2
-    return default_window(config if config is not None else EpisodeConfig())
+        check_window_given(args.t1, args.t2, ("--t1", "--t2"))
+        return (args.t1, args.t2), "--t1/--t2"
+    return default_window(config if config is not None else EpisodeConfig(), getattr(args, "params", None))
+
+
+def chosen_window(args: argparse.Namespace, config: EpisodeConfig | None = None) -> tuple[float, float]:
+    """The torque-free period to compare against none (`chosen_window_and_source`)."""
+    return chosen_window_and_source(args, config)[0]
+
+
+def window_line(window: tuple[float, float], source: str) -> str:
+    """The line a command prints of the window it compares with none: its ends and where it comes from."""
+    return f"window {window[0]:g}-{window[1]:g} s: {source}"
 
 
 def steps(text: str) -> list[float]:
@@ -330,7 +410,8 @@ def positive_list(text: str) -> list[float]:
 
 # What a command walks when neither --t1/--t2 nor --policy is given (`add_window_options`).
 WINDOW_DEFAULTS = {
-    "learned": "the gait's own window, else the default gait's learned one (0.3672-0.8629 s)",
+    "learned": "the gait's own window, else the one its gait file declares (compare_window; the default gait's: "
+               "its learned 0.3672-0.8629 s); a gait that declares none needs --t1/--t2",
     "gait": "the gait's own window (none when it has none)",
     "none": "no window",
 }

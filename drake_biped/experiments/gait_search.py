@@ -238,7 +238,7 @@ def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1, mutati
         else:
             value = value + rng.gauss(0.0, step * sigma / 0.1)
         values[f"{section}.{name}"] = min(hi, max(lo, value))
-    return config.override(values)
+    return config.override(values, sampled=True)
 
 
 def _walk(config: EpisodeConfig) -> dict[str, Any]:
@@ -841,7 +841,7 @@ def decode(start: EpisodeConfig, mutations, x, sigma: float = 0.1) -> EpisodeCon
     for xi, (section, name, kind, value, step, lo, hi) in zip(x, _coordinates(start, mutations)):
         value = value * math.exp(step * sigma / 0.1 * xi) if kind == "log" else value + step * sigma / 0.1 * xi
         values[f"{section}.{name}"] = min(hi, max(lo, float(value)))
-    return start.override(values)
+    return start.override(values, sampled=True)
 
 
 def _scored(args) -> tuple[float, dict]:

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.learners.base import Learner
-from drake_biped.learners.common import check_seed, restored
+from drake_biped.learners.common import check_mean, check_number, check_seed, restored
 
 
 class CmaesLearner(Learner):
@@ -31,12 +31,9 @@ class CmaesLearner(Learner):
 
     def __init__(self, mean: Sequence[float] = (0.5, 0.5), variance: float = 0.04, seed: int | None = None,
                  popsize: int | None = None):
-        start = np.asarray(mean, dtype=float)
-        if start.shape != (2,) or not np.all(np.isfinite(start)):
-            raise ValueError(f"mean must be two finite numbers (t1, t2), got {mean!r}")
-        if not (isinstance(variance, (int, float)) and math.isfinite(variance) and variance > 0):
-            raise ValueError(f"variance must be a finite number > 0, got {variance!r}")
-        if popsize is not None and (not isinstance(popsize, int) or popsize < 2):
+        start = check_mean(mean, "CmaesLearner")
+        variance = check_number(variance, "CmaesLearner", "variance", 0.0, lo_open=True)
+        if popsize is not None and (not isinstance(popsize, int) or isinstance(popsize, bool) or popsize < 2):
             raise ValueError(f"popsize must be an integer >= 2, got {popsize!r}")
         seed = check_seed(seed, "CmaesLearner")
         if seed is None:

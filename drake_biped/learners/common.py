@@ -1,7 +1,8 @@
-"""Checks every learner shares: its seed, and a saved state handed to `from_state`."""
+"""Checks every learner shares: its settings' numbers, its seed, and a saved state handed to `from_state`."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TypeVar
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from drake_biped.params import ParameterError
 
-__all__ = ["check_seed", "restored"]
+__all__ = ["check_mean", "check_number", "check_seed", "restored"]
 
 T = TypeVar("T")
 
@@ -21,6 +22,32 @@ def check_seed(seed: Any, owner: str) -> int | None:
     if not isinstance(seed, (int, np.integer)) or isinstance(seed, (bool, np.bool_)) or seed < 0:
         raise ParameterError(f"{owner}: seed must be an integer >= 0 or None, got {seed!r}")
     return int(seed)
+
+
+def _is_real(value: Any) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_number(value: Any, owner: str, name: str, lo: float, hi: float = math.inf, lo_open: bool = False,
+                 hi_open: bool = False) -> float:
+    """`value` as a float: a finite number (a bool or a string is none) in [lo, hi] (an end open where told);
+    ParameterError naming `owner`'s setting `name` and the value otherwise."""
+    inside = _is_real(value) and math.isfinite(value) and (value > lo if lo_open else value >= lo) and \
+        (value < hi if hi_open else value <= hi)
+    if not inside:
+        span = (f"{'>' if lo_open else '>='} {lo:g}" if hi == math.inf
+                else f"in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}")
+        raise ParameterError(f"{owner}: {name} must be a finite number {span}, got {value!r:.60}")
+    return float(value)
+
+
+def check_mean(mean: Any, owner: str) -> np.ndarray:
+    """The policy's mean (t1, t2) in s as a float array: two finite numbers (no bools, no strings);
+    ParameterError naming `owner`'s mean otherwise."""
+    values = list(mean) if isinstance(mean, (Sequence, np.ndarray)) and not isinstance(mean, str) else None
+    if values is None or len(values) != 2 or not all(_is_real(v) and math.isfinite(v) for v in values):
+        raise ParameterError(f"{owner}: mean must be two finite numbers (t1, t2), got {mean!r:.60}")
+    return np.asarray(values, dtype=float)
 
 
 def restored(cls_name: str, state: Any, required: Sequence[str], restore: Callable[[Mapping[str, Any]], T]) -> T:

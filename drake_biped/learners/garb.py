@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.learners.base import Learner
-from drake_biped.learners.common import check_seed, restored
+from drake_biped.learners.common import check_mean, check_number, check_seed, restored
 from drake_biped.paper import TABLE_II
 
 
@@ -43,12 +43,11 @@ def _check_schedule(schedule) -> tuple[tuple[int | None, float], ...]:
     previous = 0
     for k, band in enumerate(schedule):
         last, rate = band
-        if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate >= 0):
-            raise ValueError(f"schedule[{k}]: learning rate {rate!r} must be a finite number >= 0")
+        rate = check_number(rate, f"GarbLearner: schedule[{k}]", "learning rate", 0.0)
         if last is None:
             if k != len(schedule) - 1:
                 raise ValueError(f"schedule[{k}]: only the last band may be open-ended (None)")
-        elif not isinstance(last, int) or last <= previous:
+        elif not isinstance(last, int) or isinstance(last, bool) or last <= previous:
             raise ValueError(f"schedule[{k}]: band ends must be increasing integers, got {last!r}")
         else:
             previous = last
@@ -72,16 +71,9 @@ class GarbLearner(Learner):
         schedule: Sequence[tuple[int | None, float]] = TABLE_II,
         seed: int | None = None,
     ):
-        mean = np.asarray(mean, dtype=float)
-        if mean.shape != (2,) or not np.all(np.isfinite(mean)):
-            raise ValueError(f"mean must be two finite numbers (t1, t2), got {mean!r}")
-        if not (isinstance(variance, (int, float)) and math.isfinite(variance) and variance > 0):
-            raise ValueError(f"variance must be a finite number > 0, got {variance!r}")
-        if not (isinstance(beta, (int, float)) and 0.0 <= beta < 1.0):
-            raise ValueError(f"beta must be in [0, 1), got {beta!r}")
-        self.mean = mean
-        self.variance = float(variance)
-        self.beta = float(beta)
+        self.mean = check_mean(mean, "GarbLearner")
+        self.variance = check_number(variance, "GarbLearner", "variance", 0.0, lo_open=True)
+        self.beta = check_number(beta, "GarbLearner", "beta", 0.0, 1.0, hi_open=True)
         self.schedule = _check_schedule(schedule)
         self.trace = np.zeros(2)
         self.baseline = 0.0

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.learners.base import Learner
-from drake_biped.learners.common import check_seed, restored
+from drake_biped.learners.common import check_mean, check_number, check_seed, restored
 
 
 class PgpeLearner(Learner):
@@ -32,17 +32,11 @@ class PgpeLearner(Learner):
 
     def __init__(self, mean: Sequence[float] = (0.5, 0.5), variance: float = 0.04, seed: int | None = None,
                  mean_rate: float = 0.2, sigma_rate: float = 0.1):
-        m = np.asarray(mean, dtype=float)
-        if m.shape != (2,) or not np.all(np.isfinite(m)):
-            raise ValueError(f"mean must be two finite numbers (t1, t2), got {mean!r}")
-        if not (isinstance(variance, (int, float)) and math.isfinite(variance) and variance > 0):
-            raise ValueError(f"variance must be a finite number > 0, got {variance!r}")
-        for label, rate in (("mean_rate", mean_rate), ("sigma_rate", sigma_rate)):
-            if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate >= 0):
-                raise ValueError(f"{label} must be a finite number >= 0, got {rate!r}")
-        self.mean = m
+        self.mean = check_mean(mean, "PgpeLearner")
+        variance = check_number(variance, "PgpeLearner", "variance", 0.0, lo_open=True)
         self.sigma = np.full(2, math.sqrt(variance))
-        self.mean_rate, self.sigma_rate = float(mean_rate), float(sigma_rate)
+        self.mean_rate = check_number(mean_rate, "PgpeLearner", "mean_rate", 0.0)
+        self.sigma_rate = check_number(sigma_rate, "PgpeLearner", "sigma_rate", 0.0)
         self.baseline: float | None = None
         self.best = -math.inf
         self.episodes = 0
