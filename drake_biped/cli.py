@@ -25,11 +25,14 @@ from drake_biped.params import ParameterError
 def cmd_figures(args: argparse.Namespace) -> int:
     from drake_biped.analysis.figures import learning_figures
     from drake_biped.common.learning_record import check_learning_record
+    from drake_biped.common.options import check_writable
     from drake_biped.records import read_json
 
-    out = Path(args.dir)
-    path = out / "learning.json"
+    given = Path(args.dir)  # the run's folder, or its learning.json
+    path = given if given.is_file() or (given.suffix == ".json" and not given.is_dir()) else given / "learning.json"
+    out = path.parent
     record = check_learning_record(read_json(path, "figures DIR"), f"figures DIR: {path}")
+    check_writable(out, f"figures DIR: {str(out)!r}")
     for p in learning_figures(record, out):
         print(f"wrote {p}")
     return 0
@@ -129,13 +132,14 @@ def build_parser() -> argparse.ArgumentParser:
         command.set_defaults(func=module.command, resumable=getattr(module, "RESUMABLE", False),
                              growable=tuple(getattr(module, "GROWABLE", ())))
     figs = sub.add_parser("figures", help="redraw a learning run's figures and Table V from its records")
-    figs.add_argument("dir", help="the learning run's output folder")
+    figs.add_argument("dir", help="the learning run's output folder (or its learning.json)")
     figs.set_defaults(func=cmd_figures)
     for command in sub.choices.values():  # every command that writes a folder can be told to replace it
         if any(a.dest == "out" for a in command._actions):
             command.add_argument("--overwrite", action="store_true",
                                  help="replace the records of another run (another command or other settings) "
-                                      "in --out; without it such a folder is refused")
+                                      "in --out, deleting only the files its run file lists; write beside files no "
+                                      "run listed; without it such a folder is refused")
     return parser
 
 
@@ -241,8 +245,10 @@ def _failures_as_one_line(prefix: str, debug: bool, again: str,
         _exit(130, f"{prefix}: interrupted; {again}")
     except (ParameterError, ModelError) as exc:
         _remove_empty_made_folders()
-        if debug:
-            raise
+        if debug:  # the traceback too, but bad input keeps its exit code
+            import traceback
+
+            traceback.print_exc()
         _exit(2, f"{prefix}: error: {_one_line(exc)}")
     except Exception as exc:  # a failed run: one line, the traceback on request
         if debug:

@@ -125,6 +125,45 @@ def test_prediction_of_a_linear_map_is_exact():
         assert np.allclose(predicted[k], d)
 
 
+def test_an_interrupted_analysis_resumes_from_its_kept_evaluations_to_the_same_numbers(tmp_path):
+    """Each finished task's evaluations are kept as it finishes: a rerun after an interrupt evaluates only the
+    points not kept, each once, and finds the same fixed point and Jacobians, to the bit; another map's kept
+    evaluations are not read."""
+    from drake_biped.common.floquet_runs import kept_batch
+
+    step, _, x_star = _chosen_map()
+    evaluated = []
+
+    def runner(stop_after=None):
+        def run_chunks(groups):
+            for i, group in reversed(list(enumerate(groups))):  # finishing in any order
+                if stop_after is not None and len(evaluated) >= stop_after:
+                    raise KeyboardInterrupt
+                evaluated.extend(group)
+                yield i, [step(np.array(p)).tolist() for p in group]
+        return run_chunks
+
+    def analysis(evaluate):
+        fixed = fq.newton_fixed_point(evaluate, x_star + 0.05, 1e-5, tolerance=1e-12)
+        sweep = fq.epsilon_sweep(evaluate, fixed.state, [1e-6, 1e-5, 1e-4])
+        return [fixed.state, *(r["jacobian"] for r in sweep)]
+
+    identity = {"config": {"gait": "chosen"}}
+    reference = analysis(kept_batch(runner(), 2, identity))
+    total, evaluated[:] = len(evaluated), []
+    with pytest.raises(KeyboardInterrupt):
+        analysis(kept_batch(runner(stop_after=total // 2), 2, identity, tmp_path / "kept"))
+    kept = len(evaluated)
+    assert 0 < kept < total and len(list((tmp_path / "kept").glob("*.json"))) > 0
+    evaluated[:] = []
+    resumed = analysis(kept_batch(runner(), 2, identity, tmp_path / "kept"))
+    assert len(evaluated) == total - kept
+    assert all(np.array_equal(a, b) for a, b in zip(resumed, reference))
+    evaluated[:] = []
+    analysis(kept_batch(runner(), 2, {"config": {"gait": "another"}}, tmp_path / "kept"))
+    assert len(evaluated) == total
+
+
 def test_a_failed_step_is_reported():
     with pytest.raises(fq.StepFailed, match="failed"):
         fq.difference_jacobian(fq.serial(lambda x: None if x[0] > 0 else x), np.zeros(2), 0.1)

@@ -121,6 +121,56 @@ def test_bad_settings_are_refused():
         StabilitySettings(spread=0.7)
 
 
+def test_a_short_distance_is_refused_once_with_the_distance_that_is_enough():
+    """The distance named is enough for every touchdown the analysis needs, so it is accepted when given."""
+    import re
+
+    def refusal(distance_m, kicks=(0.005,)):
+        config = EpisodeConfig().override({"sim.distance_m": distance_m})
+        try:
+            StabilitySettings(trials=1, config=config, jacobian_kicks=kicks).check_walks_reach()
+        except ParameterError as exc:
+            return str(exc)
+        return None
+
+    first = refusal(2.0)
+    enough = float(re.search(r"walk at least ([\d.]+) m", first).group(1))
+    assert "touchdown 9" in first and refusal(enough) is None
+    assert f"walk at least {enough:g} m" in refusal(enough - 1.0)
+    assert "needs touchdown 6" in refusal(2.0, kicks=())  # without the Jacobian, the equilibrium's touchdowns
+
+
+def test_the_window_compared_is_the_walked_gaits_and_named_or_the_command_asks_for_one(tmp_path, capsys):
+    """Stability and push-margin compare the window of the gait they walk, from its file, and print where it
+    comes from; a gait that declares none is refused (exit 2) with what to give, never given another's."""
+    from drake_biped.cli import build_parser
+    from drake_biped.experiments import push_margin, stability
+    from drake_biped.params import LEARNED_WINDOW_S
+    from drake_biped.resources import gait_compare_window, gait_path
+
+    def settings(*argv):
+        args = build_parser().parse_args([*argv, "--out", str(tmp_path / "o")])
+        return (stability if argv[0] == "stability" else push_margin).settings_from_args(args)
+
+    for command in ("stability", "push-margin"):
+        paper = settings(command, "--params", "paper")
+        assert paper.window == (0.1, 0.2) and "window map" in paper.window_source
+        assert capsys.readouterr().out.startswith("window 0.1-0.2 s: the cheapest window of this gait's window map")
+        assert settings(command).window == LEARNED_WINDOW_S
+        assert "learned" in capsys.readouterr().out
+        with pytest.raises(ParameterError, match="--params steady: the gait declares no window.*--t1 and --t2"):
+            settings(command, "--params", "steady")
+        assert settings(command, "--params", "steady", "--t1", "0.2", "--t2", "0.3").window == (0.2, 0.3)
+        assert capsys.readouterr().out == "window 0.2-0.3 s: --t1/--t2\n"
+    assert gait_compare_window("default")[0] == LEARNED_WINDOW_S
+    # the key is no parameter of the walk: the file still reads as a configuration
+    assert EpisodeConfig.from_dict(json.loads(gait_path("paper").read_text())).window.active is False
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"compare_window": {"start_s": 0.3, "end_s": 0.2, "source": "x"}}))
+    with pytest.raises(ParameterError, match="compare_window: start_s 0.3, end_s 0.2"):
+        gait_compare_window(bad)
+
+
 @pytest.mark.slow
 def test_a_rerun_recomputes_nothing(tmp_path):
     from drake_biped.common.executor import dask_client
@@ -130,12 +180,14 @@ def test_a_rerun_recomputes_nothing(tmp_path):
     seen = []
     with dask_client(workers=1) as client:
         first = run_stability(tmp_path, base, s, client)
-        stamps = {p.name: p.stat().st_mtime_ns for p in (tmp_path / "episodes").iterdir()}
+        stamps = {str(p): p.stat().st_mtime_ns for p in (tmp_path / "episodes").rglob("*.json")}
         again = run_stability(tmp_path, base, s, client, progress=lambda d, t: seen.append((d, t)))
-    assert len(stamps) == 6 + 6  # six cells' episodes, and the Jacobian at 3 kick sizes per condition
+    # six cells' episodes, the Jacobian at 3 kick sizes per condition, and each Jacobian's reference walk
+    assert len(stamps) == 6 + 6 + 6
+    assert (tmp_path / "episodes" / "jacobian_with_0.01" / "reference.json").is_file()
     # 1.2 m is too short for the Jacobian at touchdown 8: recorded as such, not a crash
     assert all("walk further" in j["error"] for c in ("without", "with") for j in first["jacobian"][c])
-    assert {p.name: p.stat().st_mtime_ns for p in (tmp_path / "episodes").iterdir()} == stamps
+    assert {str(p): p.stat().st_mtime_ns for p in (tmp_path / "episodes").rglob("*.json")} == stamps
     assert seen == [(6, 6)]
     assert json.dumps(first["cells"], sort_keys=True) == json.dumps(again["cells"], sort_keys=True)
 

@@ -95,25 +95,80 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, force:
             raise ParameterError(f"--scheduler {scheduler}: the scheduler answers but has no workers (none joined "
                                  f"within {WORKER_WAIT_S:g} s); start one: dask worker {scheduler}") from None
         watch = WorkerWatch(client, scheduler)
+        interrupted = False
         try:
             yield client
         except BaseException as exc:
+            interrupted = isinstance(exc, KeyboardInterrupt)
             if watch.lost is not None and not isinstance(exc, (KeyboardInterrupt, SystemExit)):
                 raise ClusterLost(watch.lost) from exc  # its tasks were cancelled: the workers were gone
             raise
         finally:
             watch.stop()
-            client.close()
+            _close(client, None, interrupted)
         return
     n = workers or max(1, os.cpu_count() or 1)
     with _workers_ignore_ctrl_c():
         cluster = _local_cluster(n)
     client = Client(cluster)
+    interrupted = False
     try:
         yield client
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
+        _close(client, cluster, interrupted)
+
+
+# The loggers silenced while a client closes after an interrupt (Dask's, and asyncio's and tornado's under it).
+_SHUTDOWN_LOGGERS = ("distributed", "asyncio", "tornado")
+
+
+class _AbandonedWaits(logging.Filter):
+    """Drops asyncio's "Task exception was never retrieved" for the waits of a gather that Ctrl-C (or SIGTERM)
+    abandoned: distributed's AllExit, raised in each as the client closes and cancels their futures, whenever the
+    tasks are collected, which may be after the client is gone."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        from distributed.client import AllExit
+
+        exc = record.exc_info[1] if record.exc_info else None
+        return not isinstance(exc, AllExit)
+
+
+_ABANDONED_WAITS = _AbandonedWaits()
+
+
+def _close(client: Any, cluster: Any, interrupted: bool) -> None:
+    """Close the client, then its local cluster (None: a scheduler's, left running). After an interrupt, quietly:
+    the run has already stopped and says so in one line, so what Dask logs and raises while closing under the
+    abandoned tasks (cancelled futures, closed comms) is not news."""
+    if not interrupted:
         client.close()
-        cluster.close()
+        if cluster is not None:
+            cluster.close()
+        return
+    import asyncio
+
+    from distributed.comm import CommClosedError
+
+    logging.getLogger("asyncio").addFilter(_ABANDONED_WAITS)
+    loggers = [logging.getLogger(name) for name in _SHUTDOWN_LOGGERS]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL + 1)
+    try:
+        for closing in (client, cluster):
+            if closing is None:
+                continue
+            try:
+                closing.close()
+            except (asyncio.CancelledError, CommClosedError, OSError, TimeoutError, RuntimeError):
+                pass
+    finally:
+        for logger, level in zip(loggers, levels):
+            logger.setLevel(level)
 
 
 class ClusterLost(RuntimeError):

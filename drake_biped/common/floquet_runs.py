@@ -7,12 +7,18 @@ two cross-checks: the linearisation's prediction of a small perturbation's next 
 iterated, and against the simulation continued without restarting (the controller is a sampled-data
 system: the map restarts the 1 ms update grid at the section, a continued walk keeps its own grid phase, and
 the difference between them is measured as the gait's sensitivity to the sampling phase).
+
+Each task's evaluations of the map are kept in OUT/step_map/ as it finishes (`kept_batch`): a rerun into the
+same folder evaluates only the points not kept, and writes the record an uninterrupted run writes.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,7 +35,7 @@ from drake_biped.params import EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import write_record
 from drake_biped.versions import versions
 
-__all__ = ["FloquetSettings", "analyse", "run"]
+__all__ = ["FloquetSettings", "analyse", "kept_batch", "run"]
 
 DEFAULT_EPSILONS = tuple(float(10.0 ** e) for e in np.arange(-8.0, -2.49, 0.5))
 
@@ -90,25 +96,71 @@ class FloquetSettings:
                 "period_transient": self.period_transient, "period_tolerance": self.period_tolerance}
 
 
-def _batch(client, config: dict[str, Any], template: dict[str, Any]) -> fq.Batch:
-    """A batch evaluator of the step map on `client`: the points split evenly over its workers."""
+# Where a run keeps its step map's evaluations as they finish (`kept_batch`), inside its output folder.
+KEPT_EVALUATIONS = "step_map"
+
+# A batch's evaluations not yet known, in groups: run_chunks(groups) yields (index of a group, its images: a
+# list of numbers each, None for a fall) as each group finishes, in any order.
+ChunkRunner = Callable[[list[list[list[float]]]], Iterator[tuple[int, list[list[float] | None]]]]
+
+
+def kept_batch(run_chunks: ChunkRunner, chunks: int, identity: dict[str, Any], keep: Path | None = None) -> fq.Batch:
+    """A batch evaluator of a map that evaluates each point once: a point already evaluated (in this run, or
+    kept in `keep` by an earlier one of the same map, `identity`) is read back; the others go to `run_chunks`
+    in at most `chunks` groups, and each group is kept in `keep` (one file, atomically) as it finishes. An
+    interrupted run, rerun, resumes: its Newton iterates, Jacobian columns and checks ask for the same points
+    and find the finished ones, so the map is never evaluated twice at a point and the record is the one an
+    uninterrupted run writes. An image that is not finite is not kept (it fails the analysis as it comes)."""
+    from drake_biped.records import read_kept, write_atomic
+
+    digest = hashlib.sha256(json.dumps(identity, sort_keys=True).encode()).hexdigest()
+    known: dict[bytes, list[float] | None] = {}
+
+    def key(point: list[float]) -> bytes:
+        return np.asarray(point, dtype=float).tobytes()
+
+    if keep is not None:
+        for path in sorted(Path(keep).glob("*.json")):
+            saved = read_kept(path)
+            if isinstance(saved, dict) and saved.get("map") == digest:
+                known.update((key(p), y) for p, y in zip(saved["points"], saved["images"]))
+
+    def evaluate(points):
+        points = [np.asarray(p, dtype=float).tolist() for p in points]
+        todo = list({key(p): p for p in points if key(p) not in known}.values())
+        size = max(1, math.ceil(len(todo) / chunks))
+        groups = [todo[i : i + size] for i in range(0, len(todo), size)]
+        for index, images in run_chunks(groups):
+            group = groups[index]
+            known.update((key(p), y) for p, y in zip(group, images))
+            finite = all(np.all(np.isfinite(p)) and (y is None or np.all(np.isfinite(y)))
+                         for p, y in zip(group, images))
+            if keep is not None and finite:
+                name = hashlib.sha256(json.dumps([digest, group]).encode()).hexdigest()[:24]
+                Path(keep).mkdir(parents=True, exist_ok=True)
+                write_atomic(Path(keep) / f"{name}.json", {"map": digest, "points": group, "images": list(images)})
+        return [None if known[key(p)] is None else np.array(known[key(p)]) for p in points]
+
+    return evaluate
+
+
+def _batch(client, config: dict[str, Any], template: dict[str, Any], keep: Path | None = None) -> fq.Batch:
+    """A batch evaluator of the step map on `client`: the points not yet evaluated split evenly over its
+    workers, each task's evaluations kept in `keep` as it finishes (`kept_batch`)."""
+    from distributed import as_completed
+
     from drake_biped.common.executor import DrakeGuarded
     from drake_biped.step_map import evaluate_task
 
     workers = max(1, len(client.scheduler_info()["workers"]))
 
-    def evaluate(points):
-        points = [np.asarray(p, dtype=float).tolist() for p in points]
-        size = max(1, math.ceil(len(points) / (2 * workers)))
-        chunks = [points[i : i + size] for i in range(0, len(points), size)]
-        futures = [client.submit(DrakeGuarded(evaluate_task), config, template, chunk, pure=False)
-                   for chunk in chunks]
-        out = []
-        for part in client.gather(futures):
-            out.extend(None if y is None else np.array(y) for y in part)
-        return out
+    def run_chunks(groups):
+        futures = {client.submit(DrakeGuarded(evaluate_task), config, template, group, pure=False): i
+                   for i, group in enumerate(groups)}
+        for future in as_completed(list(futures)):
+            yield futures[future], future.result()
 
-    return evaluate
+    return kept_batch(run_chunks, 2 * workers, {"config": config, "template": template}, keep)
 
 
 def decay_size(settings: FloquetSettings, plateau: dict[str, Any], radius: float) -> float:
@@ -166,8 +218,9 @@ def orbit_period(settings: FloquetSettings, evaluate: fq.Batch, z0: np.ndarray, 
             "spread": float(np.max(np.ptp(orbit.points, axis=0)))}
 
 
-def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
-    """The fixed point, the sweep, the multipliers and the cross-checks of `settings.config`'s gait."""
+def analyse(settings: FloquetSettings, client, keep: Path | None = None) -> dict[str, Any]:
+    """The fixed point, the sweep, the multipliers and the cross-checks of `settings.config`'s gait; each step
+    map evaluation kept in `keep` as it finishes, and read back from there by a rerun (`kept_batch`)."""
     from drake_biped.step_map import SectionMap
 
     wall0 = time.perf_counter()
@@ -175,7 +228,7 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
     z0, template = section_map.start(settings.settle_steps)
     names = list(section_map.names)
     cfg, tmpl = settings.config.to_dict(), template.to_dict()
-    evaluate = _batch(client, cfg, tmpl)
+    evaluate = _batch(client, cfg, tmpl, keep)
     period = orbit_period(settings, evaluate, z0, section_map.section_normal())
 
     fixed = fq.newton_fixed_point(evaluate, z0, settings.newton_epsilon, tolerance=settings.newton_tolerance,
@@ -270,13 +323,13 @@ def analyse(settings: FloquetSettings, client) -> dict[str, Any]:
 
 def run(settings: FloquetSettings, out: Path, client=None) -> dict[str, Any]:
     """Compute on `client` (a LocalCluster when None); write floquet.json, floquet.md, floquet.png into
-    `out`. The record."""
+    `out`, the step map's evaluations kept in `out`/step_map as they finish (a rerun resumes). The record."""
     check_settings(settings, FloquetSettings, "floquet.run")
     from drake_biped.common.executor import client_or_local
 
     out = Path(out)
     with client_or_local(client) as c:
-        record = analyse(settings, c)
+        record = analyse(settings, c, out / KEPT_EVALUATIONS)
     record.update(config=settings.config.to_dict(), settings=settings.to_dict(), seed=settings.config.seed,
                   versions=versions())
     write_record(out, "floquet", record, markdown, figure)

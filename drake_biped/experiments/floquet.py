@@ -21,6 +21,8 @@ from drake_biped.common.options import (
 )
 
 COMMAND = "floquet"
+# Rerunning the command on the same --out resumes it: the step map's evaluations are kept as they finish.
+RESUMABLE = True
 
 
 PARSER = dict(help="the gait's periodic orbit (Newton on the full-state step map) and its "
@@ -36,7 +38,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--epsilons", type=positive_list, default=None,
                    help="perturbation sizes of the sweep, comma-separated (default 1e-8 to 3e-3, half decades)")
     add_cluster_options(p)
-    p.add_argument("--out", required=True, type=out_folder, help="output folder")
+    p.add_argument("--out", required=True, type=out_folder, help="output folder (rerun the same command to resume)")
 
 
 def settings_from_args(args: argparse.Namespace) -> FloquetSettings:

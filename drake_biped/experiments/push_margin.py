@@ -25,12 +25,13 @@ from drake_biped.common.options import (
     add_cluster_options,
     add_episode_options,
     add_window_options,
-    chosen_window,
+    chosen_window_and_source,
     count,
     episode_config,
     number,
     out_folder,
     run_command,
+    window_line,
 )
 from drake_biped.common.walks import CONDITIONS, condition_window, steady_step
 from drake_biped.paper import PUSH_DURATION_S
@@ -63,6 +64,7 @@ class PushMarginSettings:
     settle_s: float = 5.0
     push_duration_s: float = PUSH_DURATION_S
     force: bool = False
+    window_source: str | None = None  # where the window comes from, in words (the record's window_source)
 
     def __post_init__(self) -> None:
         for name in ("max_force_n", "force_step_n", "settle_s", "push_duration_s"):
@@ -179,6 +181,8 @@ def run(settings: PushMarginSettings, out: Path, client=None, progress: bool = T
             client_or_local(client) as c:
         record = push_margin(settings, c, progress=tick, keep=out / "walks")
     record.update(config=settings.config.to_dict(), versions=code)
+    if settings.window_source is not None:
+        record["window_source"] = settings.window_source
     write_record(out, "push_margin", record, markdown, figure)
     return record
 
@@ -207,8 +211,11 @@ def settings_from_args(args: argparse.Namespace) -> PushMarginSettings:
     config = episode_config(args)
     if args.distance is None:  # a push at --settle s (about 6 m), then room to recover or fall
         config = config.override({"sim.distance_m": 12.0, "sim.max_time_s": max(config.sim.max_time_s, 72.0)})
-    return PushMarginSettings(config, chosen_window(args, config), max_force_n=args.max_force, force_step_n=args.force_step,
-                              phases=args.phases, settle_s=args.settle, force=args.force)
+    window, source = chosen_window_and_source(args, config)
+    settings = PushMarginSettings(config, window, max_force_n=args.max_force, force_step_n=args.force_step,
+                                  phases=args.phases, settle_s=args.settle, force=args.force, window_source=source)
+    print(window_line(window, source))
+    return settings
 
 
 def command(args: argparse.Namespace) -> int:

@@ -10,8 +10,9 @@ each trial (never across trials) about x* = the mean undisturbed steady section 
 (touchdowns from `steady_from_step` on, of the undisturbed cell of the same condition). A trial that
 falls gives the touchdowns it made.
 
-Nothing lost: each finished episode's result is written to OUT/episodes/ (atomically); a rerun with the
-same settings reads them back and runs only what is missing.
+Nothing lost: each finished episode's result is written to OUT/episodes/ (atomically), the finite-difference
+Jacobian's walks to OUT/episodes/jacobian_CONDITION_KICK/, and with --floquet the step map's evaluations to
+OUT/floquet_CONDITION/step_map/; a rerun with the same settings reads them back and runs only what is missing.
 """
 
 from __future__ import annotations
@@ -33,11 +34,12 @@ from drake_biped.common.options import (
     check_reaches_touchdown,
     check_size,
     check_walks,
-    chosen_window,
+    chosen_window_and_source,
     count,
     episode_config,
     number,
     run_command,
+    window_line,
 )
 from drake_biped.common.walks import CONDITIONS, condition_window
 from drake_biped.paper import TABLE_VI
@@ -81,6 +83,7 @@ class StabilitySettings:
     jacobian_kicks: tuple[float, ...] = JACOBIAN_KICKS_RAD
     floquet: bool = False
     force: bool = False  # run more than MAX_WALKS walks
+    window_source: str | None = None  # where the window comes from, in words (the record's window_source)
 
     def __post_init__(self) -> None:
         t1, t2 = self.window
@@ -103,18 +106,20 @@ class StabilitySettings:
 
     def check_walks_reach(self) -> None:
         """ParameterError naming --distance, before any walk, when the gait's walks may end before the
-        touchdowns the analysis needs (`options.check_reaches_touchdown`)."""
+        touchdowns the analysis needs (`options.check_reaches_touchdown`): the furthest of them, so that the
+        distance it names is enough for all."""
         config = self.config if self.config is not None else EpisodeConfig()
-        check_reaches_touchdown(config, self.steady_from_step, "the return map's equilibrium (the undisturbed "
-                                f"sections from step {self.steady_from_step} on)")
+        needs = [(self.steady_from_step, "the return map's equilibrium (the undisturbed sections from step "
+                                         f"{self.steady_from_step} on)")]
         if self.jacobian_kicks:
-            check_reaches_touchdown(config, JACOBIAN_STEP + 1, f"the finite-difference Jacobian (kicked before "
-                                    f"touchdown {JACOBIAN_STEP})")
+            needs.append((JACOBIAN_STEP + 1, f"the finite-difference Jacobian (kicked before touchdown {JACOBIAN_STEP})"))
+        touchdown = max(n for n, _ in needs)
+        check_reaches_touchdown(config, touchdown, " and ".join(why for n, why in needs if n == touchdown))
         check_size(f"bootstrap {self.bootstrap}", self.bootstrap, MAX_BOOTSTRAP, "resamples", self.force)
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
-        for name in ("config", "jacobian_kicks", "floquet", "force"):
+        for name in ("config", "jacobian_kicks", "floquet", "force", "window_source"):
             d.pop(name)
         d["window"] = list(self.window)
         return d
@@ -242,7 +247,7 @@ def run_stability(out: Path, base: EpisodeConfig, settings: StabilitySettings, c
                     continue
             try:
                 fd = finite_difference_jacobian(config, client, angle_rad=size, rate_radps=10 * size,
-                                                seed=settings.seed)
+                                                seed=settings.seed, keep=path.with_suffix(""))
             except (RuntimeError, ParameterError) as exc:
                 fd = {"angle_rad": size, "rate_radps": 10 * size, "error": str(exc)}
             write_atomic(path, {"config": config.to_dict(), "jacobian": fd})
@@ -265,7 +270,7 @@ def _section(result: dict[str, Any], index: int) -> np.ndarray | None:
 
 def finite_difference_jacobian(base: EpisodeConfig, client, step: int = JACOBIAN_STEP, angle_rad: float = 0.005,
                                rate_radps: float = 0.05, lead_s: float = 0.03, kicks: int = 16,
-                               seed: int = 0) -> dict[str, Any]:
+                               seed: int = 0, keep: Path | None = None) -> dict[str, Any]:
     """The step-to-step Jacobian of the gait at touchdown `step`, by finite differences in Drake.
 
     The unperturbed walk gives touchdown n = `step` at T_n. `kicks` more walks kick the swing hip `lead_s`
@@ -278,8 +283,11 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = JACOBIAN
     clock, phase reset and torque-free window start on the 1 ms update grid), so the step map carries small
     jumps where a touchdown moves across an update; a pair of kicks can land on either side of one, and many
     kicks average them out, as the regression does with pushes. The residual says how large they are.
+
+    `keep`: a folder where each walk is kept as it finishes (KEEP/reference.json, KEEP/kick_K.json), read back
+    by a rerun; None keeps nothing.
     """
-    from drake_biped.common.executor import episode_task
+    from drake_biped.common.executor import episode_task, run_kept
 
     if not isinstance(step, int) or step < 2:
         raise ParameterError(f"step {step!r}: must be an integer >= 2")
@@ -288,7 +296,10 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = JACOBIAN
     if not isinstance(kicks, int) or kicks < 3:
         raise ParameterError(f"kicks {kicks!r}: must be an integer >= 3")
     cfg = base.to_dict()
-    ref = client.submit(episode_task, cfg, pure=False).result()
+    if keep is None:
+        ref = client.submit(episode_task, cfg, pure=False).result()
+    else:
+        ref = run_kept(client, {0: (Path(keep) / "reference.json", cfg)})[0]
     x0, y0 = _section(ref, step), _section(ref, step + 1)
     if x0 is None or y0 is None:
         raise ParameterError(f"the unperturbed walk has no touchdowns {step} and {step + 1}: walk further "
@@ -301,7 +312,11 @@ def finite_difference_jacobian(base: EpisodeConfig, client, step: int = JACOBIAN
     angles = phase + 2 * np.pi * np.arange(kicks) / kicks
     plan = [{"time_s": t_kick, "hip_angle_rad": float(np.cos(a) * angle_rad),
              "hip_rate_radps": float(np.sin(a) * rate_radps)} for a in angles]
-    runs = client.gather([client.submit(episode_task, cfg, k, pure=False) for k in plan])
+    if keep is None:
+        runs = client.gather([client.submit(episode_task, cfg, k, pure=False) for k in plan])
+    else:
+        kept = run_kept(client, {i: (Path(keep) / f"kick_{i}.json", cfg, k) for i, k in enumerate(plan)})
+        runs = [kept[i] for i in range(len(plan))]
     dx, dy, lost = [], [], 0
     for r in runs:
         x, y = _section(r, step), _section(r, step + 1)
@@ -356,6 +371,8 @@ def run(settings: StabilitySettings, out: Path, client=None, progress: bool = Tr
                                    jacobian_kicks=settings.jacobian_kicks)
         if settings.floquet:  # (the finite-difference Jacobian's episodes follow the cells, without a bar)
             record["floquet"] = _floquet(config, settings.window, out, c)
+    if settings.window_source is not None:
+        record["window_source"] = settings.window_source
     write_atomic(out / "stability.json", record)
     write_stability_outputs(record, out)
     return record
@@ -402,10 +419,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def settings_from_args(args: argparse.Namespace) -> StabilitySettings:
     """The stability study's settings from the command's options."""
     config = episode_config(args)
-    settings = StabilitySettings(window=chosen_window(args, config), trials=args.trials, push_force_n=args.push,
+    window, source = chosen_window_and_source(args, config)
+    settings = StabilitySettings(window=window, trials=args.trials, push_force_n=args.push,
                                  spread=args.spread, seed=config.seed, config=config, floquet=args.floquet,
-                                 force=args.force)
+                                 force=args.force, window_source=source)
     settings.check_walks_reach()
+    print(window_line(window, source))
     return settings
 
 
