@@ -16,14 +16,18 @@ from drake_biped.records import save_figure
 def markdown(record: dict[str, Any]) -> str:
     """bifurcation.md: one row per point."""
     jitter = record["jitter_tolerance_s"]
+    lyapunov = record.get("lyapunov", True)  # records before the key always walked the neighbours
+    exponent_text = (f"Lyapunov: a finite-size exponent (per step) from a neighbour walk kicked by "
+                     f"{NEIGHBOUR_KICK_RADPS:g} rad/s on the swing hip." if lyapunov
+                     else "No neighbour walks (--no-lyapunov): no Lyapunov exponents.")
     lines = [f"# Bifurcation over {record['param']}", "",
              f"Walks of {record['distance_m']:g} m; the steps within {record['transient_m']:g} m of the first "
              f"touchdown dropped; period-k where every k-th of the last periods varies by less than "
              f"{1e3 * record['period_tolerance_s']:g} ms (period-1: the last {record['period_window']}), and read "
-             f"again at {1e3 * jitter:g} ms, the scale of the controller's jitter. Lyapunov: a finite-size exponent "
-             f"(per step) from a neighbour walk kicked by {NEIGHBOUR_KICK_RADPS:g} rad/s on the swing hip.", "",
+             f"again at {1e3 * jitter:g} ms, the scale of the controller's jitter. {exponent_text}", "",
              f"| {record['param']} | step (ms) | attractor | at {1e3 * jitter:g} ms | last {record['period_window']} step "
-             "periods (s) | Lyapunov | long-run C_mt (95 %) |", "|---|---|---|---|---|---|---|"]
+             f"periods (s) |{' Lyapunov |' if lyapunov else ''} long-run C_mt (95 %) |",
+             "|---|---|---|---|---|" + ("---|" if lyapunov else "") + "---|"]
     for p in record["points"]:
         periods = p["step_periods_s"][-record["period_window"]:]
         span = f"{min(periods):.3f}–{max(periods):.3f}" if periods else "—"
@@ -36,7 +40,7 @@ def markdown(record: dict[str, Any]) -> str:
             cmt = (format_cost_interval(p["cost_of_transport"], 0.5 * (hi - lo)) if lo is not None
                    else format_cost(p["cost_of_transport"]))
         lines.append(f"| {p['value']:g} | {1e3 * p['time_step_s']:g} | {p['attractor']} | "
-                     f"{p['within_jitter']['attractor']} | {span} | {exponent} | {cmt} |")
+                     f"{p['within_jitter']['attractor']} | {span} |{f' {exponent} |' if lyapunov else ''} {cmt} |")
     up_to = record.get("walked_up_to")
     values = record["values"]
     if up_to is None:

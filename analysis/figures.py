@@ -13,8 +13,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drake_biped.analysis import rewalks  # noqa: E402
-from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval  # noqa: E402
-from drake_biped.analysis.series import cmt_change, moving_average, period  # noqa: E402
+from drake_biped.analysis.cost_of_transport import cost_decimals, format_cost  # noqa: E402
+from drake_biped.analysis.series import cmt_change, moving_average, period, spread_text  # noqa: E402
 from drake_biped.kinematics import B_TORSO_COM_X, B_TORSO_COM_Z, TABLE_I_BODY, leg_points  # noqa: E402
 from drake_biped.paper import SLOPE_MOVING_AVERAGE as MOVING_AVERAGE  # noqa: E402
 from drake_biped.paper import TABLE_V, TABLE_V_REDUCTION  # noqa: E402
@@ -310,8 +310,9 @@ def table_v(record: dict) -> str:
 
     ours_learned = fmt(learned)
     if learned is not None:
-        ours_learned = (f"{format_cost_interval(learned, ev['learned_std_cost_of_transport'])} "
-                        f"({ev['learned_walks']} of {len(ev['learned'])} trials walk)")
+        spread = spread_text(ev["learned_std_cost_of_transport"], ev["learned_walks"],
+                             lambda sd: f"{sd:.{cost_decimals(learned)}f}")
+        ours_learned = f"{fmt(learned)} {spread} ({ev['learned_walks']} of {len(ev['learned'])} trials walk)"
     reduction = ev.get("reduction")
     lines = [
         "# Table V: cost of transport C_mt = E+ / (m g d)",

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from drake_biped.analysis.cost_of_transport import format_cost
+from drake_biped.analysis.rewalks import saving_spread
 from drake_biped.analysis.series import cmt_change
 
 __all__ = ["RUNNING", "best_walking_window", "compare", "episodes_to_within", "markdown", "running_cost"]
@@ -78,6 +79,7 @@ def compare(record: dict[str, Any], best: dict[str, Any] | None, tolerance: floa
         "learned_walks": ev.get("learned_walks"),
         "rewalked_saving": rewalks.get("mean_saving"),
         "rewalked_saving_std": rewalks.get("std_saving"),
+        "rewalked_spread": saving_spread(rewalks) if rewalks.get("mean_saving") is not None else None,
         "rewalked_holding": rewalks.get("holding"),
         "trials": len(record["trials"]),
         "mean_distance_to_best_s": None if best is None else float(np.mean(distance)),
@@ -97,8 +99,8 @@ def _rewalked(row: dict[str, Any]) -> str:
     """The learner's re-walked C_mt change with its spread and the trials holding (`rewalks`)."""
     if row.get("rewalked_saving") is None:
         return "—"
-    return (f"{cmt_change(row['rewalked_saving'])} ± {100 * row['rewalked_saving_std']:.1f} % "
-            f"({row['rewalked_holding']}/{row['trials']})")
+    spread = row.get("rewalked_spread") or f"± {100 * row['rewalked_saving_std']:.1f} %"
+    return f"{cmt_change(row['rewalked_saving'])} {spread} ({row['rewalked_holding']}/{row['trials']})"
 
 
 def _wall(row: dict[str, Any]) -> str:

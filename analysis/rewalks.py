@@ -20,7 +20,7 @@ import numpy as np
 
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.long_run import measure_text
-from drake_biped.analysis.series import cmt_change, window_text
+from drake_biped.analysis.series import cmt_change, spread_text, window_text
 
 __all__ = ["CHANGES", "HOLD_SAVING", "headline", "markdown", "measured_cost", "summary", "window_acted"]
 
@@ -89,8 +89,17 @@ def summary(time_step_s: float, speed_mps: float, learned: list[dict[str, Any]],
         "trials": trials,
         "mean_saving": float(np.mean(means)) if means else None,
         "std_saving": float(np.std(means)) if means else None,
+        "saving_trials": len(means),
         "holding": sum(t["holds"] for t in trials),
     }
+
+
+def saving_spread(record: dict[str, Any]) -> str:
+    """The spread of the mean saving over the trials that have one: "± 1.2 %", or "(1 trial)"."""
+    count = record.get("saving_trials")
+    if count is None:  # a record before the count was kept: its trials tell, else its spread prints as kept
+        count = sum(t["mean_saving"] is not None for t in record["trials"]) if "trials" in record else 2
+    return spread_text(record["std_saving"], count, lambda sd: f"{100 * sd:.1f} %")
 
 
 def _change(saving: float | None) -> str:
@@ -134,6 +143,6 @@ def headline(record: dict[str, Any]) -> str:
     if record["mean_saving"] is None:
         return f"No trial's window walks under any change ({n} trials)."
     return (f"C_mt change with the learned windows, re-walked: {cmt_change(record['mean_saving'])} "
-            f"(± {100 * record['std_saving']:.1f} %, mean over trials of each trial's mean over its "
+            f"({saving_spread(record).strip('()')}, mean over trials of each trial's mean over its "
             f"{len(record['changes'])} walks); {record['holding']} of {n} trials save ≥ "
             f"{100 * record['hold_saving']:.0f} % in every walk.")

@@ -29,6 +29,14 @@ def period(t1: float, t2: float) -> float:
     return float(max(0.0, max(0.0, t2) - max(0.0, t1)))
 
 
+def spread_text(sd: float | None, count: int, text, unit: str = "trial") -> str:
+    """The spread printed beside a mean over `count` samples: "± " and `text(sd)`, or "(1 trial)" where fewer
+    than two samples leave no spread to measure (a standard deviation of 0 over one trial says nothing)."""
+    if sd is None or count < 2:
+        return f"({count} {unit}{'' if count == 1 else 's'})"
+    return f"± {text(sd)}"
+
+
 def window_text(t1: float, t2: float, digits: int = 3) -> str:
     """A (t1, t2) sample or mean as the window it walks, in words: "0.367–0.863 s", or "none (t2 <= t1)" when
     it gives no torque-free period (times below 0 act as 0)."""

@@ -11,6 +11,7 @@ Registered, it is made by name like the shipped ones, and `drake-biped learn --l
 import numpy as np
 
 import drake_biped as db
+from drake_biped.analysis.series import window_text  # a sample as the window it walks
 from drake_biped.cli import integer, number, run_script, script_parser  # the commands' option checks
 
 
@@ -58,8 +59,8 @@ def main() -> None:
         t1, t2 = learner.ask()
         result = db.run_episode(base.replace(window=db.TorqueFreeWindow(max(0.0, t1), max(0.0, t2))))
         learner.tell((t1, t2), db.reward(result.cost_of_transport, result.distance_m, args.distance))
-        print(f"episode {episode:2d}: window {t1:.3f}-{t2:.3f} s, C_mt {result.cost_of_transport or float('nan'):.4f}, "
-              f"best window so far ({learner.mean[0]:.3f}, {learner.mean[1]:.3f}), sigma {learner.sigma:.3f}")
+        print(f"episode {episode:2d}: window {window_text(t1, t2)}, C_mt {result.cost_of_transport or float('nan'):.4f}, "
+              f"best window so far {window_text(*learner.mean)}, sigma {learner.sigma:.3f}")
 
 
 run_script(main)  # a bad value is one line and exit code 2, a failed run one line and 1, as for drake-biped

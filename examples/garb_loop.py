@@ -6,6 +6,7 @@ This is what `drake-biped learn` runs for each trial (there on Dask, with record
 """
 
 import drake_biped as db
+from drake_biped.analysis.series import window_text  # a sample as the window it walks
 from drake_biped.cli import integer, number, run_script, script_parser  # the commands' option checks
 
 parser = script_parser(__doc__)
@@ -26,7 +27,7 @@ def main() -> None:
         result = db.run_episode(base.replace(window=window))
         r = db.reward(result.cost_of_transport, result.distance_m, args.distance)  # eq. 13 with the fall rule
         learner.update((t1, t2), r)
-        print(f"episode {episode:3d}: window {t1:.3f}-{t2:.3f} s, {result.distance_m:5.2f} m, reward {r:.3f}, "
+        print(f"episode {episode:3d}: window {window_text(t1, t2)}, {result.distance_m:5.2f} m, reward {r:.3f}, "
               f"policy mean ({learner.mean[0]:.3f}, {learner.mean[1]:.3f})")
 
 

@@ -99,3 +99,44 @@ def test_envelopes_and_the_slope_premise():
     assert p["without_up_to"] == 0.02 and p["with_up_to"] == 0.0 and p["band"] == [0.01, 0.02, 0.04] and p["holds"]
     assert not bifurcation.premise(with_window, without)["holds"]  # the window never fails where none climbs
     assert bifurcation.premise(points([False, True]), points([False, True]))["band"] == []
+
+
+def test_options_that_would_change_nothing_are_refused_naming_them(capsys, tmp_path):
+    argv = ["bifurcation", "--param", "u_a", "--out", str(tmp_path / "b")]
+    code, lines = run_cli(capsys, [*argv, "--from", "2", "--to", "2.5", "--num", "1"])
+    assert code == 2
+    one_line(lines, "--num 1 --from 2 --to 2.5", "--to would change nothing")
+    code, lines = run_cli(capsys, [*argv, "--from", "2", "--to", "2", "--num", "3"])  # one value three times
+    assert code == 2
+    one_line(lines, "value 2 is given twice")
+    assert bifurcation.BifurcationSettings(param="u_a", values=(2.0,)).values == (2.0,)  # --num 1 --to = --from
+
+
+def test_an_unread_gain_is_refused_for_being_unread_not_for_the_window():
+    """The default gait carries no window: the old message blamed t2 <= t1 for any parameter that changed nothing."""
+    with pytest.raises(ParameterError) as refused:
+        bifurcation.BifurcationSettings(param="gait.motor_limit_nm", values=(20.0, 30.0))
+    assert "unread under this gait's hip drive 'servo'" in str(refused.value)
+    assert "t2 <= t1" not in str(refused.value)
+
+
+def test_a_slope_sweep_whose_walks_end_on_the_level_is_refused():
+    config = EpisodeConfig().override({"sim.distance_m": 12.0, "sim.max_time_s": 80.0,
+                                       "ground.slope_rad": 0.01, "ground.level_length_m": 20.0})
+    with pytest.raises(ParameterError, match="--distance 12 --level-length 20"):
+        bifurcation.BifurcationSettings(config, "slope", (0.01, 0.02), transient_m=3.0)
+
+
+def test_without_lyapunov_the_report_describes_no_exponent():
+    point = {"value": 0.3, "time_step_s": 0.001, "attractor": "period-1", "within_jitter": {"attractor": "period-1"},
+             "step_periods_s": [0.5] * 20, "lyapunov": None, "cost_of_transport": None}
+    record = {"param": "t1", "values": [0.3], "distance_m": 60.0, "transient_m": 10.0, "period_tolerance_s": 0.002,
+              "period_window": 20, "jitter_tolerance_s": 0.01, "points": [point], "walked_up_to": 0.3}
+    from drake_biped.analysis.bifurcation_report import markdown
+
+    with_it = markdown(record)
+    assert "Lyapunov: a finite-size exponent" in with_it and "| Lyapunov |" in with_it
+    without = markdown({**record, "lyapunov": False})
+    assert "finite-size exponent" not in without and "| Lyapunov |" not in without
+    assert "no Lyapunov exponents" in without
+    assert all(line.count("|") == 7 for line in without.splitlines() if line.startswith("|"))

@@ -53,7 +53,16 @@ def test_garb_loop(tmp_path):
     rewards = [float(x) for x in re.findall(r"reward (\d+\.\d+)", text)]
     assert len(rewards) == 3 and all(r > 0 for r in rewards)
     assert text.count("policy mean") == 3
+    assert_windows_walkable(text, 3)
+    assert "window none (t2 0.387 <= t1 0.413)" in text  # seed 0's first sample: t2 < t1, no window walked
     assert written(tmp_path) == []
+
+
+def assert_windows_walkable(text: str, count: int) -> None:
+    """Every window printed is one an episode walks: none (t2 <= t1), or 0 <= t1 < t2."""
+    windows = re.findall(r"window (none \(t2 [-\d.]+ <= t1 [-\d.]+\)|(\d+\.\d+)–(\d+\.\d+) s)", text)
+    assert len(windows) == count, text
+    assert all(w.startswith("none") or 0 <= float(a) < float(b) for w, a, b in windows), windows
 
 
 @pytest.mark.slow
@@ -78,8 +87,9 @@ def test_custom_learner(tmp_path):
     text = run(tmp_path, "custom_learner.py", "--episodes", "4", "--distance", "1.5")
     cmt = [float(x) for x in re.findall(r"C_mt (\d+\.\d+)", text)]
     assert len(cmt) == 4 and text.count("best window so far") == 4
-    best = re.findall(r"best window so far \((\d\.\d+), (\d\.\d+)\)", text)
+    best = re.findall(r"best window so far (\d\.\d+)–(\d\.\d+) s", text)
     assert best[0] == ("0.300", "0.400")  # the first episode walks the start itself
+    assert_windows_walkable(text.replace("best window so far", "best"), 4)
     assert written(tmp_path) == []
 
 

@@ -179,3 +179,19 @@ def test_every_shipped_gait_names_all_its_gains():
         data = json.loads(gait_path(name).read_text())
         for section in ("cpg", "gait", "initial"):
             assert set(data[section]) == set(full[section]), (name, section)
+
+
+def test_a_value_given_twice_is_refused_naming_the_axis_and_the_value():
+    with pytest.raises(ParameterError, match="grid axis cpg.u_a: value 2.0 is given twice"):
+        parse_spec({"axes": {"u_a": {"values": [2.0, 2.2, 2.0]}}})
+    with pytest.raises(ParameterError, match="value 2.0 is given twice"):
+        parse_spec({"axes": {"u_a": {"min": 2.0, "max": 2.0, "points": 2}}})
+
+
+def test_an_axis_over_an_unread_gain_is_refused_for_being_unread():
+    from drake_biped.experiments.grid import check_axes
+
+    with pytest.raises(ParameterError) as refused:
+        check_axes(EpisodeConfig(), [Axis("gait.motor_limit_nm", (20.0, 30.0))])
+    assert "unread under this gait's hip drive 'servo'" in str(refused.value)
+    assert "t2 <= t1" not in str(refused.value)

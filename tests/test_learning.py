@@ -278,3 +278,45 @@ def test_a_record_that_gave_another_learner_garbs_settings_still_resumes():
     assert _fixed(old) == _fixed(new)
     garb = make_settings(EpisodeConfig(), 1, 1, seed=0)
     assert _fixed({**garb, "learner": {**garb["learner"], "beta": 0.5}}) != _fixed(garb)  # GARB's own count
+
+
+def test_a_variance_wider_than_a_windows_declared_times_is_refused(tmp_path, capsys):
+    """A standard deviation of 1000 s draws windows that no episode can walk: what it learns says nothing."""
+    with pytest.raises(SystemExit) as stop:
+        main(["learn", "--variance", "1e6", "--out", str(tmp_path / "l")])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "--variance 1e+06" in err and "0-10 s" in err
+    make_settings(EpisodeConfig(), 1, 1, 0, variance=100.0)  # a standard deviation of the whole span is taken
+
+
+def test_one_trial_has_no_spread_to_print(tmp_path):
+    """`learn --trials 1`: Table V and the re-walks say "(1 trial)", never "± 0" over one trial."""
+    from drake_biped.analysis.figures import table_v
+    from drake_biped.analysis.rewalks import headline
+
+    record = {"settings": _settings(episodes=1, trials=1), "trials": [],
+              "evaluation": {"no_window": {"cost_of_transport": 0.221, "fell": False},
+                             "learned": [{"trial": 0, "t1": 0.15, "t2": 0.55, "cost_of_transport": 0.140,
+                                          "fell": False}],
+                             "learned_mean_cost_of_transport": 0.140, "learned_std_cost_of_transport": 0.0,
+                             "learned_walks": 1, "reduction": 1 - 0.140 / 0.221}}
+    table = table_v(record)
+    assert "0.1400 (1 trial)" in table and "±" not in table
+    one = {"trials": [{"mean_saving": 0.3}], "mean_saving": 0.3, "std_saving": 0.0, "changes": ["a", "b"],
+           "holding": 1, "hold_saving": 0.35}
+    assert "(1 trial," in headline(one) and "±" not in headline(one)
+    two = {**one, "trials": [{"mean_saving": 0.3}, {"mean_saving": 0.4}], "std_saving": 0.05}
+    assert "(± 5.0 %," in headline(two)
+
+
+def test_figures_takes_the_learning_json_itself(tmp_path):
+    episodes = [{"episode": 1, "t1": 0.2, "t2": 0.5, "mean_t1": 0.5, "mean_t2": 0.5, "reward": 4.0, "baseline": 4.0,
+                 "cost_of_transport": 0.25, "distance_m": 10.0, "fell": False, "fall_reason": "", "duration_s": 15.0,
+                 "steps": 18}]
+    record = {"settings": _settings(episodes=1, trials=1), "trials": [{"trial": 0, "episodes": episodes}],
+              "evaluation": {"no_window": {"cost_of_transport": 0.221, "fell": False}, "learned": [],
+                             "learned_walks": 0}}
+    (tmp_path / "learning.json").write_text(json.dumps(record))
+    assert main(["figures", str(tmp_path / "learning.json")]) == 0
+    assert (tmp_path / "table_v.md").stat().st_size > 0 and not (tmp_path / "learning.json" / "table_v.md").exists()

@@ -71,3 +71,38 @@ def test_landscape_command_reads_a_window_map(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["landscape", str(tmp_path / "missing")])
     assert "no window map" in capsys.readouterr().err
+
+
+def test_landscape_refuses_a_folder_it_cannot_write_before_computing(tmp_path, capsys, monkeypatch):
+    """Without --out it writes beside the window map: that folder is checked first, not after the draws."""
+    import json
+    import os
+    import pathlib
+
+    from drake_biped.experiments import landscape as command
+    from tests.test_failures import one_line, run_cli
+
+    record = {"config": {"sim": {"distance_m": 10.0}}, "baseline": {"cost_of_transport": 0.2, "distance_m": 10.0},
+              "windows": [{"t1": 0.1, "t2": 0.3, "cost_of_transport": 0.1, "distance_m": 10.0}]}
+    (tmp_path / "window_map.json").write_text(json.dumps(record))
+
+    def computed(*args, **kwargs):
+        raise AssertionError("the landscape was computed")
+
+    monkeypatch.setattr(command, "landscape", computed)
+    if os.geteuid() == 0:  # root writes into a mode-555 folder: deny the write as the kernel would for anyone else
+        write_text = pathlib.Path.write_text
+
+        def denied(self, *args, **kwargs):
+            if self.parent == tmp_path:
+                raise PermissionError(13, "Permission denied")
+            return write_text(self, *args, **kwargs)
+
+        monkeypatch.setattr(pathlib.Path, "write_text", denied)
+    tmp_path.chmod(0o555)
+    try:
+        code, lines = run_cli(capsys, ["landscape", str(tmp_path)])
+    finally:
+        tmp_path.chmod(0o755)
+    assert code == 2
+    one_line(lines, f"the window map folder '{tmp_path}'", "cannot write there (Permission denied)")

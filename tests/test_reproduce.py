@@ -170,7 +170,14 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     logs.clear()
     again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append, gait="default").run_all()
     assert logs == [f"[{step}] finished earlier: reused" for step in steps_of(SMOKE, "default")]
-    assert again == summaries and (tmp_path / "report.md").read_text() == text
+    # the same numbers, each step now named as reused from the folder's records, not measured by this run
+    assert all(s.pop("reused") for s in again.values()) and again == summaries
+    from drake_biped.analysis.reproduce_report import provenance_text
+
+    rerun = (tmp_path / "report.md").read_text()
+    reused = provenance_text({k: {**s, "reused": True} for k, s in summaries.items()})
+    assert reused.startswith("Measured by this run: none.") and reused in rerun
+    assert rerun.replace(reused, provenance_text(summaries)) == text
     # a full run leaves what a quick run checks: its verdict rows, keyed, and its learned windows' C_mt
     import json
 
@@ -431,3 +438,26 @@ def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monk
     assert "Slope story" not in text.split("## Experiment 1")[0].split("| what | paper |")[0]
     assert [v[0] for v in verdicts if v[0].startswith("Slope story")] == [
         "Slope story, 0.02 rad (Figs. 8–9)", "Slope story, 2.0° with the grid's best (Figs. 10–11)"]
+
+
+def test_a_report_says_which_steps_this_run_measured_and_which_it_reused(tmp_path):
+    """A folder resumed (or copied) from other records: their steps are named as reused, with the code that
+    measured them, never as measured by this run."""
+    from drake_biped.analysis.reproduce_report import provenance_text
+
+    copied = Reproduction(tmp_path, QUICK, None, log=lambda _: None)
+    first = copied.experiment("walk", {"d": 1}, lambda folder: {"distance_m": 1.0})
+    assert "reused" not in first and set(first["measured_by"]) == {"drake_biped", "git_commit", "drake"}
+    again = Reproduction(tmp_path, QUICK, None, log=lambda _: None)
+    reused = again.experiment("walk", {"d": 1}, lambda folder: pytest.fail("walked again"))
+    assert reused["reused"] and reused["measured_by"] == first["measured_by"]
+    fresh = again.experiment("grid", {"p": 2}, lambda folder: {"points": 2})
+    text = provenance_text({"walk": reused, "grid": fresh})
+    code = first["measured_by"]
+    assert "Measured by this run: grid." in text
+    assert (f"not measured again: walk (measured by drake-biped {code['drake_biped']} ({code['git_commit']}), "
+            f"Drake {code['drake']})") in text
+    assert "every number below is measured by this run" not in text.lower()
+    assert provenance_text({"grid": fresh}) == "Every number below is measured by this run."
+    old = provenance_text({"walk": {"reused": True}, "grid": fresh})  # a summary from before code was recorded
+    assert "walk (measured by code not recorded)" in old

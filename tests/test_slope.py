@@ -88,6 +88,8 @@ def test_start_from_learning_takes_the_best_trials_learner_state(tmp_path):
     (["slope", "--slope", "-0.02"], "must be > 0"),
     (["slope", "--slope", "0.02", "--policy", "x.json", "--t1", "0.1", "--t2", "0.3"], "either --policy"),
     (["slope", "--slope", "0.02", "--policy", "none.json"], "no such file"),
+    # a walk that ends on the level never meets the slope: no climb verdict can be made of it
+    (["slope", "--slope", "0.02", "--level-length", "10", "--distance", "4"], "--distance 4 --level-length 10"),
 ])
 def test_slope_refuses_bad_options(tmp_path, capsys, argv, match):
     with pytest.raises(SystemExit):
@@ -142,3 +144,40 @@ def test_a_run_shorter_than_the_moving_average_has_no_first_full_average():
     s = trial_summary(episodes, 10.0)
     assert s["first_full_average_episode"] is None
     assert _first_full(None, 2) == "— (fewer than 20 episodes)"
+
+
+def _walk(distance_m, fell, target_m=10.0, level_m=2.0):
+    return {"distance_m": distance_m, "fell": fell, "fall_reason": "hip_low" if fell else "", "duration_s": 9.0,
+            "cost_of_transport": None if fell else 0.3, "mean_speed_mps": 0.5,
+            "config": {"sim": {"distance_m": target_m}, "ground": {"slope_rad": 0.02, "level_length_m": level_m}}}
+
+
+def test_a_walk_that_never_reaches_the_slope_is_judged_neither_climbing_nor_failing_to():
+    from drake_biped.analysis.rewalks import CHANGES
+    from drake_biped.experiments.slope import _rewalks, climbs, report_markdown, verdicts
+
+    assert not climbs(_walk(4.0, False, target_m=4.0, level_m=10.0))  # walked its distance, all of it level
+    assert climbs(_walk(10.0, False))
+    on_the_level = {c: _walk(1.5, True) for c in CHANGES}  # every walk of the window falls before the slope
+    up = {c: _walk(10.0, False) for c in CHANGES}
+    rewalks = {"start_window": _rewalks(on_the_level), "no_window": _rewalks(up)}
+    assert rewalks["start_window"]["none_climbs"] and not rewalks["start_window"]["all_reached_slope"]
+    v = verdicts(rewalks, [], start_period=0.5)
+    assert not v["learned_period_fails_to_climb"] and v["no_period_climbs"]
+    record = {"ground": {"slope_rad": 0.02, "level_length_m": 2.0}, "verdicts": v, "rewalks": rewalks, "trials": [],
+              "start": {"mean": [0.2, 0.7], "period_s": 0.5, "variance": 0.04},
+              "checks": {"start_window": rewalks["start_window"]["half_step"] | {"climbs": False,
+                                                                                   "reached_slope": False},
+                         "no_window": rewalks["no_window"]["half_step"]}}
+    text = report_markdown(record)
+    assert "falls on the level (never reached the slope) (hip_low): 1.50 m" in text
+    assert "| the learned torque-free period fails to climb |" in text and "| no |" in text
+
+
+def test_a_slope_run_that_ends_before_the_slope_is_refused_through_the_api():
+    from drake_biped.experiments.slope import SlopeSettings
+
+    config = load_gait("climbing").replace(sim=SimulationParams(distance_m=2.0, max_time_s=20.0))
+    with pytest.raises(ParameterError, match="--distance 2 --level-length 2"):
+        SlopeSettings(config, 0.02, 2.0)
+    SlopeSettings(config, 0.02, 1.5)  # 0.5 m up: a climb can be judged

@@ -27,6 +27,7 @@ means no torque-free period, as in the paper.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,7 +53,7 @@ from drake_biped.paper import (
     LEARNING_TRIALS,
     TABLE_II,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow
+from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, parameter_info
 from drake_biped.records import read_json, write_atomic
 from drake_biped.versions import versions
 
@@ -183,6 +184,16 @@ class Trial:
                                  "learner": self.learner.state()})
 
 
+def check_policy_spread(variance: float) -> None:
+    """ParameterError naming --variance when the policy's standard deviation per time exceeds the span a window's
+    time is declared over (TorqueFreeWindow's bounds, 0-10 s): its draws would mostly fall outside the windows
+    an episode can walk (below 0 they act as 0), and what it learned would say nothing of the windows."""
+    lo, hi = parameter_info(TorqueFreeWindow, "start_s")["bounds"]
+    if isinstance(variance, (int, float)) and math.isfinite(variance) and variance > (hi - lo) ** 2:
+        raise ParameterError(f"--variance {variance:g}: a standard deviation of {math.sqrt(variance):g} s is wider "
+                             f"than a window's declared times ({lo:g}-{hi:g} s); give at most {(hi - lo) ** 2:g} s^2")
+
+
 def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
                   mean=(0.5, 0.5), variance: float = 0.04, beta: float = 0.8, schedule=TABLE_II,
                   learner: str = DEFAULT_LEARNER, options: dict[str, Any] | None = None, force: bool = False
@@ -196,6 +207,7 @@ def make_settings(config: EpisodeConfig, trials: int, episodes: int, seed: int,
     check_learning_size(f"--trials {trials} x --episodes {episodes}", trials * episodes, force)
     if not isinstance(seed, int) or seed < 0:
         raise ParameterError(f"--seed {seed!r}: must be an integer >= 0")
+    check_policy_spread(variance)
     try:
         cls = learner_class(learner)
     except ParameterError as exc:

@@ -46,8 +46,10 @@ from drake_biped.common.options import (
     episode_config,
     number,
     out_folder,
+    why_unchanged,
 )
 from drake_biped.common.walks import JITTER_MAX_PERIOD, JITTER_TOLERANCE_S, attractor_of_walk
+from drake_biped.experiments.slope import check_reaches_slope
 from drake_biped.params import (
     EpisodeConfig,
     ParameterError,
@@ -87,6 +89,10 @@ class BifurcationSettings:
         resolve_field(self.param)  # ParameterError naming an unknown parameter
         if not self.values or any(not (isinstance(v, (int, float)) and math.isfinite(v)) for v in self.values):
             raise ParameterError(f"bifurcation: values must be finite numbers, got {self.values!r}")
+        twice = sorted({float(v) for v in self.values if list(self.values).count(v) > 1})
+        if twice:  # a value given twice walks the same walk twice: two identical rows
+            raise ParameterError(f"bifurcation: --param {self.param} value {twice[0]:g} is given twice; each value "
+                                 "walks once")
         if self.second_time_step_s is not None and not (math.isfinite(self.second_time_step_s)
                                                         and self.second_time_step_s > 0):
             raise ParameterError(f"--second-time-step must be positive, got {self.second_time_step_s!r}")
@@ -99,14 +105,14 @@ class BifurcationSettings:
         if self.second_time_step_s is not None and self.second_time_step_s == self.config.sim.time_step_s:
             raise ParameterError(f"--second-time-step {self.second_time_step_s:g} is the gait's own plant step: it "
                                  "walks every value again to the same result")
-        walked = [self.config.override({self.param: float(v)}).as_walked() for v in self.values]
+        for v in self.values:  # over the slope, the envelope is the steepest slope climbed: the walks must reach it
+            check_reaches_slope(self.config.override({self.param: float(v)}, sampled=True), f"--param {self.param} {v:g}: ")
+        walked = [self.config.override({self.param: float(v)}, sampled=True).as_walked() for v in self.values]
         if len(self.values) > 1 and all(w == walked[0] for w in walked):
             span = f"--param {self.param} --from {min(self.values):g} --to {max(self.values):g}"
-            if not any(w.window.active for w in walked):
-                raise ParameterError(f"{span}: the torque-free window never opens at any value (t2 <= t1 at each), so "
-                                     "every value walks the same episode without one; give --t2 (or --t1) so that "
-                                     "a window opens")
-            raise ParameterError(f"{span}: every value walks the same episode; this parameter changes nothing here")
+            why = why_unchanged(self.config, self.param, self.values)
+            hint = "; give --t2 (or --t1) so that a window opens" if "never opens" in why else ""
+            raise ParameterError(f"{span}: changes nothing: {why}{hint}")
 
     @property
     def time_steps(self) -> tuple[float, ...]:
@@ -123,7 +129,7 @@ def point_config(settings: BifurcationSettings, value: float, time_step_s: float
     (the controller's clock kept: refined with the plant under the paper's clock, a fixed-rate loop kept)."""
     from drake_biped.params import with_time_step
 
-    config = settings.config.override({settings.param: float(value)})
+    config = settings.config.override({settings.param: float(value)}, sampled=True)
     if time_step_s != config.sim.time_step_s:
         config = config.replace(sim=with_time_step(config.sim, time_step_s, "--second-time-step"))
     return config
@@ -214,6 +220,7 @@ def bifurcation(settings: BifurcationSettings, out: Path, client, progress=None)
             "time_steps_s": list(settings.time_steps), "transient_m": settings.transient_m,
             "distance_m": distance, "period_window": PERIOD_WINDOW, "period_tolerance_s": PERIOD_TOLERANCE_S,
             "jitter_tolerance_s": settings.jitter_tolerance_s, "max_period": MAX_PERIOD, "points": points,
+            "lyapunov": settings.lyapunov,
             "walked_up_to": walked_up_to([p for p in points if p["time_step_s"] == settings.time_steps[0]])}
 
 
@@ -280,7 +287,12 @@ def settings_from_args(args: argparse.Namespace) -> BifurcationSettings:
         t1, t2 = policy_window(Path(args.policy))
         config = config.override({"window.start_s": t1, "window.end_s": t2})
     named = {"window.start_s": args.t1, "window.end_s": args.t2}
-    config = config.override({k: v for k, v in named.items() if v is not None})
+    # one end of the window may be given alone: --param sweeps the other, and a sweep that never opens it is
+    # refused as changing nothing
+    config = config.override({k: v for k, v in named.items() if v is not None}, sampled=True)
+    if args.num == 1 and args.stop != args.start:
+        raise ParameterError(f"--num 1 --from {args.start:g} --to {args.stop:g}: one value walks --from alone and "
+                             "--to would change nothing; give --num >= 2, or --to equal to --from")
     values = tuple(float(v) for v in np.linspace(args.start, args.stop, args.num))
     return BifurcationSettings(config, args.param, values, second_time_step_s=args.second_time_step,
                                transient_m=args.transient, jitter_tolerance_s=args.jitter_tolerance,

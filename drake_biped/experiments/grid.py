@@ -43,6 +43,7 @@ from drake_biped.common.options import (
     count,
     episode_config,
     print_lines,
+    why_unchanged,
 )
 from drake_biped.paper import TABLE_IV as PAPER_TABLE_IV
 from drake_biped.params import SHORT_NAMES, EpisodeConfig, ParameterError, check_settings, walked_the_distance
@@ -81,6 +82,9 @@ class Axis:
         for v in self.values:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise ParameterError(f"grid axis {self.name}: value {v!r} is not a finite number")
+        twice = [v for k, v in enumerate(self.values) if v in self.values[:k]]
+        if twice:  # every point with it would be walked, and listed, twice
+            raise ParameterError(f"grid axis {self.name}: value {twice[0]!r} is given twice; give each value once")
 
 
 def field_name(name: str) -> str:
@@ -138,7 +142,10 @@ def parse_spec(spec: Any, source: str = "grid spec") -> list[Axis]:
         else:
             raise ParameterError(f"{source}: axis {name}: expected {{min, max, points}} or {{values: [...]}}, "
                                  f"got {entry!r}")
-        axes.append(Axis(dotted, values))
+        try:
+            axes.append(Axis(dotted, values))
+        except ParameterError as exc:
+            raise ParameterError(f"{source}: {exc}") from None
     if len({a.name for a in axes}) != len(axes):
         raise ParameterError(f"{source}: an axis is given twice (short and dotted names of one field)")
     return axes
@@ -176,11 +183,10 @@ def check_axes(config: EpisodeConfig, axes, source: str = "GridSettings.axes") -
     for axis, name in zip(axes, names):
         if len(set(axis.values)) < 2:
             continue
-        walked = [config.override({name: float(v)}).as_walked() for v in axis.values]
+        walked = [config.override({name: float(v)}, sampled=True).as_walked() for v in axis.values]
         if all(w == walked[0] for w in walked):
             raise ParameterError(f"{source}: axis {axis.name} ({min(axis.values):g} to {max(axis.values):g}) "
-                                 "changes nothing: every value walks the same episode (a window's time while "
-                                 "t2 <= t1, a level stretch on level ground?)")
+                                 f"changes nothing: {why_unchanged(config, name, axis.values)}")
 
 
 def check_size(axes: list[Axis] | tuple[Axis, ...], force: bool = False, source: str = "GridSettings.axes",

@@ -14,6 +14,7 @@ from drake_biped.analysis.series import signed_percent
 from drake_biped.common.options import (
     check_memory,
     check_size,
+    check_writable,
     count,
     number,
     out_folder,
@@ -78,11 +79,11 @@ def run(settings: LandscapeSettings, out: Path | None = None, client=None, progr
         rewards = WindowRewards.from_window_map(read_json(path, "landscape: window map"))
     except (KeyError, TypeError) as exc:
         raise ParameterError(f"{path} is not a window map ({exc})") from None
+    out = Path(out) if out is not None else path.parent
+    check_writable(out, f"landscape: {'--out' if out != path.parent else 'the window map folder'} {str(out)!r}")
     record = landscape(rewards, list(settings.variances), samples=settings.samples, seed=settings.seed,
                        starts=[tuple(s) for s in settings.starts])
     record.update(window_map=str(path), samples=settings.samples, seed=settings.seed, versions=versions())
-    out = Path(out) if out is not None else path.parent
-    out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "landscape.json", record)
     landscape_figure(record, out / "landscape.png")
     return record

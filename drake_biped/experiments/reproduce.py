@@ -242,19 +242,21 @@ class Reproduction:
         return client_or_local(self._client)
 
     def experiment(self, name: str, settings: dict[str, Any], fn: Callable[[Path], dict[str, Any]]) -> dict:
-        """fn(folder) -> summary, unless DIR/name/summary.json holds one made with these settings."""
+        """fn(folder) -> summary, with the code that measured it, unless DIR/name/summary.json holds one made with
+        these settings: that one is returned marked "reused"."""
         folder = self.out / name
         path = folder / "summary.json"
         saved = read_kept(path)
         if isinstance(saved, dict):
             if saved.get("settings") == settings:
                 self.log(f"[{name}] finished earlier: reused")
-                return saved
+                return {**saved, "reused": True}  # the report says it was not measured by this run
         self.log(f"[{name}] running")
         t0 = time.perf_counter()
         folder.mkdir(parents=True, exist_ok=True)
         summary = {"settings": settings, **fn(folder)}
         summary["wall_s"] = time.perf_counter() - t0
+        summary["measured_by"] = {k: versions().get(k) for k in ("drake_biped", "git_commit", "drake")}
         write_atomic(path, summary)
         self.log(f"[{name}] done in {summary['wall_s']:.0f} s")
         return summary

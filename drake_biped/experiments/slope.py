@@ -37,7 +37,7 @@ import numpy as np
 from drake_biped.analysis.cost_of_transport import format_cost
 from drake_biped.analysis.rewalks import CHANGE_WORDS, CHANGES
 from drake_biped.analysis.series import moving_average, period
-from drake_biped.common.learning_runs import make_settings, run_learning, trial_seed
+from drake_biped.common.learning_runs import check_policy_spread, make_settings, run_learning, trial_seed
 from drake_biped.common.options import (
     add_episode_options,
     add_resumable_run_options,
@@ -71,6 +71,17 @@ def slope_ground(slope_rad: float, level_length_m: float = 2.0, friction: float 
     if not (math.isfinite(slope_rad) and slope_rad > 0):
         raise ParameterError(f"--slope {slope_rad!r}: must be > 0 (an ascending slope, rad)")
     return Ground(slope_rad=slope_rad, level_length_m=level_length_m, friction=friction)
+
+
+def check_reaches_slope(config: EpisodeConfig, where: str = "") -> None:
+    """ParameterError naming --distance and --level-length when `config`'s walks end on its level stretch, before
+    the slope begins: a walk that never reaches the slope cannot be judged as climbing (or as failing to), so
+    every climb verdict is refused such settings up front. `where` prefixes the message."""
+    g, distance = config.ground, config.sim.distance_m
+    if g.level_length_m is not None and g.slope_rad != 0.0 and distance <= g.level_length_m:
+        raise ParameterError(f"{where}--distance {distance:g} --level-length {g.level_length_m:g}: every walk ends "
+                             f"on the level, before the slope begins at {g.level_length_m:g} m, so none can be "
+                             "judged as climbing; give a --distance above --level-length")
 
 
 def start_from_learning(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -116,22 +127,31 @@ def _run_checks(out: Path, configs: dict[str, EpisodeConfig], client) -> dict[st
     return {name: {change: results[name, change] for change in CHANGES} for name in configs}
 
 
+def reached_slope(result: dict[str, Any]) -> bool:
+    """The episode went past its ground's level stretch, onto the slope."""
+    level = result["config"]["ground"].get("level_length_m")
+    return level is None or result["distance_m"] > level
+
+
 def climbs(result: dict[str, Any]) -> bool:
-    """The episode reached its distance without falling."""
-    return walked_the_distance(result["fell"], result["distance_m"], result["config"]["sim"]["distance_m"])
+    """The episode reached the slope and its distance without falling."""
+    return reached_slope(result) and walked_the_distance(result["fell"], result["distance_m"],
+                                                         result["config"]["sim"]["distance_m"])
 
 
 def _summary(result: dict[str, Any]) -> dict[str, Any]:
     keep = ("distance_m", "fell", "fall_reason", "duration_s", "cost_of_transport", "mean_speed_mps")
-    return {**{k: result[k] for k in keep}, "climbs": climbs(result)}
+    return {**{k: result[k] for k in keep}, "climbs": climbs(result), "reached_slope": reached_slope(result)}
 
 
 def _rewalks(walks: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """A check's re-walks (besides the walk as learned): each change's summary, and whether all four climb or
     none does."""
     rows = {change: _summary(walks[change]) for change in CHANGES[1:]}
-    every = [_summary(walks["as_learned"])["climbs"], *(r["climbs"] for r in rows.values())]
-    return {**rows, "all_climb": all(every), "none_climbs": not any(every)}
+    summaries = [_summary(walks["as_learned"]), *rows.values()]
+    every = [r["climbs"] for r in summaries]
+    return {**rows, "all_climb": all(every), "none_climbs": not any(every),
+            "all_reached_slope": all(r["reached_slope"] for r in summaries)}
 
 
 def trial_summary(episodes: list[dict[str, Any]], distance_m: float) -> dict[str, Any]:
@@ -207,11 +227,14 @@ def run_slope(out: Path, base: EpisodeConfig, ground: Ground, start_state: dict[
 def verdicts(rewalks: dict[str, dict[str, Any]], trials: list[dict[str, Any]],
              start_period: float) -> dict[str, Any]:
     """The paper's three claims about the slope as measured here, each over the four walks of its check
-    (`_rewalks`): the learned period falls in all four, no period climbs in all four, and how many trials end
-    with a shorter period that climbs in all four."""
+    (`_rewalks`): the learned period reaches the slope and fails on it in all four (a walk that falls on the
+    level never meets the slope), no period climbs in all four, and how many trials end with a shorter period
+    that climbs in all four."""
     adapted = [t for t in trials if t["final_policy_rewalks"]["all_climb"] and t["mean_period_end_s"] < start_period]
+    start = rewalks["start_window"]
     return {
-        "learned_period_fails_to_climb": rewalks["start_window"]["none_climbs"] and start_period > 0,
+        "learned_period_fails_to_climb": (start["none_climbs"] and start.get("all_reached_slope", True)
+                                          and start_period > 0),
         "no_period_climbs": rewalks["no_window"]["all_climb"],
         "learning_shrinks_the_period_until_it_climbs": len(adapted),
         "trials": len(trials),
@@ -223,14 +246,17 @@ def report_markdown(record: dict[str, Any]) -> str:
     """The slope run in words and numbers: the two checks, each trial's development, the verdicts."""
     g, start, checks, v = record["ground"], record["start"], record["checks"], record["verdicts"]
 
+    def ended(r: dict[str, Any]) -> str:
+        how = "falls" if r["fell"] else "stops"
+        return how if r.get("reached_slope", True) else f"{how} on the level (never reached the slope)"
+
     def episode(r: dict[str, Any]) -> str:
-        how = "climbs" if r["climbs"] else (f"falls ({r['fall_reason']})" if r["fell"] else "stops")
+        how = "climbs" if r["climbs"] else (f"{ended(r)} ({r['fall_reason']})" if r["fell"] else ended(r))
         cmt = "" if r["cost_of_transport"] is None else f", C_mt {format_cost(r['cost_of_transport'])}"
         return f"{how}: {r['distance_m']:.2f} m in {r['duration_s']:.1f} s{cmt}"
 
     def again(rows: dict[str, Any]) -> str:
-        return ", ".join("climbs" if rows[c]["climbs"] else
-                         f"{'falls' if rows[c]['fell'] else 'stops'} at {rows[c]['distance_m']:.2f} m"
+        return ", ".join("climbs" if rows[c]["climbs"] else f"{ended(rows[c])} at {rows[c]['distance_m']:.2f} m"
                          for c in CHANGES[1:])
 
     rewalked_words = ", ".join(CHANGE_WORDS[c] for c in CHANGES[1:])
@@ -305,6 +331,8 @@ class SlopeSettings:
                 raise ParameterError(f"{name} {value!r}: must be an integer >= 1")
         check_learning_size(f"--trials {self.trials} x --episodes {self.episodes}", self.trials * self.episodes,
                             self.force)
+        check_reaches_slope(self.config.replace(ground=self.ground()))
+        check_policy_spread(self.variance)
 
     def ground(self) -> Ground:
         return slope_ground(self.slope_rad, self.level_length_m, self.config.ground.friction)
