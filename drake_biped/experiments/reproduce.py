@@ -248,7 +248,7 @@ class Reproduction:
         path = folder / "summary.json"
         saved = read_kept(path)
         if isinstance(saved, dict):
-            if saved.get("settings") == settings:
+            if _as_walked(saved.get("settings")) == _as_walked(settings):
                 self.log(f"[{name}] finished earlier: reused")
                 return {**saved, "reused": True}  # the report says it was not measured by this run
         self.log(f"[{name}] running")
@@ -648,6 +648,25 @@ class Reproduction:
         write_report(self.out, summaries, self.profile, code, full_run, gait=self.story.gait,
                      choices=self.story.why)
         return summaries
+
+
+def _as_walked(value: Any) -> Any:
+    """Settings as they walk: every configuration in them (a mapping with "cpg" and "gait" sections) with its gait's
+    unread fields at their defaults (`GaitParams.as_walked`), so that a gait file that drops a value its readings
+    never read still reuses the records walked with it."""
+    from drake_biped.params import GaitParams
+
+    if isinstance(value, dict):
+        out = {k: _as_walked(v) for k, v in value.items()}
+        if isinstance(value.get("cpg"), dict) and isinstance(value.get("gait"), dict):
+            try:
+                out["gait"] = GaitParams.from_dict(value["gait"]).as_walked().to_dict()
+            except ValueError:
+                pass  # not a gait's section after all: compared as written
+        return out
+    if isinstance(value, list):
+        return [_as_walked(v) for v in value]
+    return value
 
 
 def steps_of(profile: Profile, gait: str = DEFAULT_STORY) -> tuple[str, ...]:
