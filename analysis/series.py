@@ -60,3 +60,17 @@ def cmt_change(saving: float | None, digits: int = 1) -> str:
     """A C_mt saving (1 - C_mt / C_mt without a window) as the signed C_mt change it is: every report signs C_mt
     as a change, so a saving of 0.377 is "-37.7 %" (C_mt fell) and a negative saving "+..." (it rose); None "—"."""
     return signed_percent(None if saving is None else -saving, digits)
+
+
+def sign_changes_per_s(times, values, segment=None) -> float:
+    """How often a held signal (a torque, one value per update) changes sign, per second of `times`: a change
+    counts between two consecutive nonzero values of opposite sign within one segment (`segment`: a label per
+    sample, e.g. the stance leg, so that a role swap is no change; a value of exactly zero, a torque-free
+    window's, neither starts nor ends one). ValueError for series of other lengths or under two samples."""
+    t, x = np.asarray(times, dtype=float), np.asarray(values, dtype=float)
+    same = np.ones(len(x), dtype=bool) if segment is None else np.asarray(segment)
+    if t.ndim != 1 or x.shape != t.shape or same.shape != t.shape or len(t) < 2 or not t[-1] > t[0]:
+        raise ValueError(f"sign_changes_per_s: times, values and segment must be one series each of the same length "
+                         f"(at least 2, over a positive time), got shapes {t.shape}, {x.shape}, {same.shape}")
+    change = (np.sign(x[1:]) * np.sign(x[:-1]) < 0) & (same[1:] == same[:-1])
+    return float(change.sum() / (t[-1] - t[0]))

@@ -195,7 +195,7 @@ LAW_COPIED = (
     ("window", "first_step", "window_first_step"),
     ("ground", "slope_rad", "ground_slope_rad"), ("ground", "level_length_m", "ground_level_length_m"),
     ("sim", "fall_hip_height_m", "fall_hip_height_m"), ("sim", "fall_pitch_rad", "fall_pitch_rad"),
-    ("gait", "motor_limit_nm", "motor_limit_nm"),
+    ("gait", "motor_limit_nm", "motor_limit_nm"), ("gait", "motor_time_constant_s", "motor_time_constant_s"),
 )
 _SECTION_TYPES = {"cpg": CpgParams, "gait": GaitParams, "window": TorqueFreeWindow, "ground": Ground,
                   "sim": SimulationParams}
@@ -237,7 +237,8 @@ LAW = VectorLayout("law", tuple(({**_DERIVED, **_COPIED})[name] for name in (
     "knee_extend_torque", "knee_hold_torque", "stance_knee_torque", "ankle_kp", "ankle_kd",
     "touchdown_min_step_s", "touchdown_height_m", "touchdown_min_advance_m", "touchdown_min_phase",
     "window_start_s", "window_end_s", "window_first_step", "ground_slope_rad", "ground_tan_slope",
-    "ground_level_length_m", "fall_hip_height_m", "fall_pitch_rad", "hip_motor", "inter_leg", "motor_limit_nm")))
+    "ground_level_length_m", "fall_hip_height_m", "fall_pitch_rad", "hip_motor", "inter_leg", "motor_limit_nm",
+    "motor_time_constant_s")))
 _o = LAW.offset
 L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("update_period_s", "state_lag_s", "alpha", "u_a",
                                                                     "u_eta", "u_r", "kappa"))
@@ -253,6 +254,7 @@ L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_
 L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
 L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
 L_MOTOR, L_INTER_LEG, L_MOTOR_LIMIT = _o("hip_motor"), _o("inter_leg"), _o("motor_limit_nm")
+L_MOTOR_TAU = _o("motor_time_constant_s")
 del _o
 
 # What the hip motor (GaitParams.hip_drive "motor") reads of the plant's dynamics at each update, computed by
@@ -576,7 +578,10 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
         rate, gain, offset = motor_model_k(law, dyn, v, dt, sw_i, st_i, others, torso)
         drive = 0.0
         if gain > 0.0:
-            drive = clip((zeta - rate - s[MOTOR_DISTURBANCE]) / gain, law[L_MOTOR_LIMIT])
+            # the part of the rate's miss this update closes: all of it (ODE's motor at its step), or dt / T of it
+            # (a motor of time constant T, whose loop does not stiffen as the step shrinks)
+            part = 1.0 if law[L_MOTOR_TAU] <= dt else dt / law[L_MOTOR_TAU]
+            drive = clip(part * (zeta - rate - s[MOTOR_DISTURBANCE]) / gain, law[L_MOTOR_LIMIT])
         tau_swing_hip = 0.0 if free >= 1.0 else (1.0 - free) * clip(offset + drive, hip_limit)
         s[MOTOR_MODEL_RATE] = rate + gain * (tau_swing_hip - offset)
     elif free >= 1.0:

@@ -259,6 +259,10 @@ class GaitParams(_Validated):
     hip_drive: str = param("servo", "", 'what realizes zeta at the hip (see GaitParams): "servo" or "motor"')
     hip_joint: str = param("swing", "", 'the motor\'s joint (see GaitParams): "swing" or "inter_leg"')
     motor_limit_nm: float = param(40.0, "N*m", "the hip motor's maximum torque (hip_drive \"motor\")", 0.0, 200.0)
+    motor_time_constant_s: float = param(
+        0.0, "s", "the hip motor's time constant (hip_drive \"motor\"; not printed): each update closes the part "
+        "min(1, update period / this) of the rate's miss, so the motor's loop has this bandwidth whatever the step; "
+        "0 closes it within each update, as ODE's motor does at ODE's step", 0.0, 0.1)
     swing_offset_rad: float = param(
         0.0, "rad", "integrated reading: a constant offset of the swing reference at the end of the half-cycle",
         -1.5, 1.5)
@@ -330,7 +334,7 @@ class GaitParams(_Validated):
     # What each reading leaves unread: the controller never reads these fields under it.
     UNREAD_BY_MOTOR = ("swing_reading", "swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain",
                        "placement_velocity_gain")  # the swing reference and its servo: ODE's motor has no angle
-    UNREAD_BY_SERVO = ("motor_limit_nm",)
+    UNREAD_BY_SERVO = ("motor_limit_nm", "motor_time_constant_s")
     UNREAD_BY_ENTRAINED = ("touchdown_min_phase",)  # the phase does not follow the steps
 
     def unread(self) -> tuple[str, ...]:

@@ -1,0 +1,70 @@
+"""The paper walker's hip motor against its plant step: the per-update motor (motor_time_constant_s 0, as shipped)
+and motors of a fixed time constant, each walked 110 m without a window at several plant steps; the long-run C_mt
+(first 10 m dropped), the step period's spread, and how often the swing hip's torque changes sign after 3 s (a
+10 m walk with its trajectory recorded):
+
+    python benchmarks/paper_motor_clock.py --out benchmarks/results/paper-walker/motor-clock --tau-ms 0 2 --h-ms 0.5 0.25 0.125
+
+One JSON file per walk, kept as it finishes: a rerun skips the walks already written."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from drake_biped.analysis.series import sign_changes_per_s
+from drake_biped.episode import run_episode
+from drake_biped.model import joint_index
+from drake_biped.resources import load_gait
+from drake_biped.versions import versions
+
+
+def swing_hip_torque_sign_changes(trajectory: dict, after_s: float = 3.0) -> tuple[float, float]:
+    """How often the swing hip's applied torque changes sign (per second, from `after_s`: analysis.series.
+    sign_changes_per_s, a role swap being no change), and the part of the updates it sits within 1 % of its
+    largest (the motor's limit when it saturates)."""
+    t, act, right = trajectory["time"], trajectory["actuation"], trajectory["stance_right"] > 0.5
+    tau = np.where(right, act[:, joint_index("left", "hip")], act[:, joint_index("right", "hip")])
+    keep = t >= after_s
+    tau, t, right = tau[keep], t[keep], right[keep]
+    return sign_changes_per_s(t, tau, right), float(np.mean(np.abs(tau) >= 0.99 * np.abs(tau).max()))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--gait", default="paper")
+    parser.add_argument("--tau-ms", type=float, nargs="+", default=[0.0, 2.0])
+    parser.add_argument("--h-ms", type=float, nargs="+", default=[0.5, 0.25, 0.125])
+    parser.add_argument("--distance", type=float, default=110.0)
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    for tau in args.tau_ms:
+        for h in args.h_ms:
+            path = args.out / f"tau{tau:g}ms-h{h:g}ms.json"
+            if path.exists():
+                continue
+            base = load_gait(args.gait).override({"gait.motor_time_constant_s": tau * 1e-3, "sim.time_step_s": h * 1e-3})
+            start = time.time()
+            short = run_episode(base, record_trajectory=True)
+            flips, saturated = swing_hip_torque_sign_changes(short.trajectory) if short.duration_s > 4.0 else (None, None)
+            config = base.override({"sim.distance_m": args.distance, "sim.max_time_s": 6 * args.distance})
+            result = run_episode(config)
+            lr = None if result.fell else result.long_run()
+            record = {"gait": args.gait, "motor_time_constant_ms": tau, "time_step_ms": h,
+                      "distance_m": result.distance_m, "fell": result.fell, "cost_of_transport": result.cost_of_transport,
+                      "long_run": lr, "sign_changes_per_s_10m": flips, "saturated_part_10m": saturated,
+                      "walked_10m": {"fell": short.fell, "distance_m": short.distance_m,
+                                     "cost_of_transport": short.cost_of_transport, "wall_s": short.wall_time_s},
+                      "wall_s": time.time() - start, "config": config.to_dict(), "versions": versions()}
+            path.write_text(json.dumps(record, indent=1) + "\n")
+            print(path.name, result.fell, round(result.distance_m, 2), lr and lr["cost_of_transport"],
+                  lr and lr["step_period_std_s"], flips, flush=True)
+
+
+if __name__ == "__main__":
+    main()
