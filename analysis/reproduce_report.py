@@ -739,11 +739,16 @@ def _check_text(check: dict[str, Any] | None) -> str:
     if not check:
         return ""
     n, agree = check["walks"], check["agree"]
+    rule = check.get("rule", "last digit")  # the record's machine: the last digit; another, or none named: a tolerance
+    within = "to the last digit" if rule == "last digit" else f"within a {rule} (the record names another machine or none)"
+    diff = check["max_relative_difference"]
+    largest = f"largest difference {'n/a' if diff is None else f'{100 * diff:.3f} %'}"
     if agree == n:
-        return (f" ✓ checked here: {n} re-walk{'s give' if n > 1 else ' gives'} the recorded C_mt to the last "
-                "digit")
-    return (f" ✗ checked here: {agree} of {n} re-walks give the recorded C_mt to the last digit "
-            f"(largest difference {_pct(check['max_relative_difference'])})")
+        if rule == "last digit":
+            return f" ✓ checked here: {n} re-walk{'s give' if n > 1 else ' gives'} the recorded C_mt {within}"
+        return (f" ✓ checked here: {n} re-walk{'s give' if n > 1 else ' gives'} the recorded C_mt {within}, "
+                f"{check.get('same_digits', 0)} of {n} to the last digit ({largest})")
+    return f" ✗ checked here: {agree} of {n} re-walks give the recorded C_mt {within} ({largest})"
 
 
 def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) -> list[dict[str, str]]:
@@ -860,7 +865,8 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         for w in check["rows"]:
             window = "none" if w["t2"] <= max(0.0, w["t1"]) else f"{max(0.0, w['t1']):.3f}–{w['t2']:.3f}"
             lines.append(f"| {check['source']} | {window} | {_num(w['recorded'], 6)} | {_num(w['measured'], 6)} | "
-                         + ("yes" if w["recorded"] == w["measured"] else _pct(w["relative_difference"])) + " |")
+                         + ("yes" if w["recorded"] == w["measured"] else
+                            f"{'agrees' if w.get('agrees') else 'no'}: {_pct(w['relative_difference'])}") + " |")
     if "learn" in s:
         lines += ["", "## Learning, a few episodes (`learn/`)", "",
                   f"GARB with the paper's settings for {s['learn']['settings']['trials']} × "

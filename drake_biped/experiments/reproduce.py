@@ -309,6 +309,7 @@ class Reproduction:
         from drake_biped.common.executor import run_kept
         from drake_biped.common.walks import window_of
         from drake_biped.resources import full_run_digest
+        from drake_biped.versions import compare_with_record
 
         digest = full_run_digest()
 
@@ -329,15 +330,24 @@ class Reproduction:
                 results = run_kept(client, jobs)
             checks = {}
             for key, rows in wanted.items():
-                out = []
+                out, rules = [], set()
                 for name, t1, t2, recorded in rows:
                     measured = results[name]["cost_of_transport"]
                     diff = (None if recorded is None or measured is None else measured / recorded - 1.0)
+                    # to the last digit on the record's machine, within a stated tolerance elsewhere
+                    if recorded is None or measured is None:
+                        agrees = recorded is None and measured is None
+                    else:
+                        comparison = compare_with_record(recorded, measured, digest["checks"][key].get("versions"))
+                        agrees = comparison.agrees
+                        rules.add("last digit" if comparison.exact else f"relative {comparison.rtol:g}")
                     out.append({"t1": t1, "t2": t2, "recorded": recorded, "measured": measured,
-                                "relative_difference": diff})
+                                "relative_difference": diff, "agrees": agrees})
                 diffs = [abs(r["relative_difference"]) for r in out if r["relative_difference"] is not None]
                 checks[key] = {"source": digest["checks"][key]["source"], "walks": len(out),
-                               "agree": sum(r["recorded"] == r["measured"] for r in out),
+                               "agree": sum(r["agrees"] for r in out),
+                               "same_digits": sum(r["recorded"] == r["measured"] for r in out),
+                               "rule": " and ".join(sorted(rules)) or "last digit",
                                "max_relative_difference": max(diffs, default=None), "rows": out}
             return {"checks": checks, "full_run_code": digest["code"]}
 
