@@ -866,7 +866,9 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
             window = "none" if w["t2"] <= max(0.0, w["t1"]) else f"{max(0.0, w['t1']):.3f}–{w['t2']:.3f}"
             lines.append(f"| {check['source']} | {window} | {_num(w['recorded'], 6)} | {_num(w['measured'], 6)} | "
                          + ("yes" if w["recorded"] == w["measured"] else
-                            f"{'agrees' if w.get('agrees') else 'no'}: {_pct(w['relative_difference'])}") + " |")
+                            f"{'agrees' if w.get('agrees') else 'no'}"
+                            + ("" if w["relative_difference"] is None else f": {100 * w['relative_difference']:+.3f} %"))
+                         + " |")
     if "learn" in s:
         lines += ["", "## Learning, a few episodes (`learn/`)", "",
                   f"GARB with the paper's settings for {s['learn']['settings']['trials']} × "
