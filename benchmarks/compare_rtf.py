@@ -2,10 +2,10 @@
 the ceiling a Python controller can reach.
 
     python benchmarks/compare_rtf.py BEFORE_TREE AFTER_TREE [--rounds 5] [--episodes 3] [--distance 10]
-                                     [--learning 40]
+                                     [--learning 40] [--gait NAME]
 
-Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) that walks the default gait
-`--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
+Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) that walks the default gait (or
+the shipped gait `--gait`, at its own step) `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
 Simulator.AdvanceTo; the first walk of a process also builds its diagram, which is not timed) and its C_mt.
 In the same round, a process of the after tree measures the ceiling on the same walk: the plant alone
 replaying the walk's logged torques (no Python during the simulation), the same plant stepped by a Python
@@ -34,7 +34,10 @@ CLOSED_LOOP = """
 import json
 from drake_biped.episode import run_episode
 from drake_biped.params import EpisodeConfig, SimulationParams
-config = EpisodeConfig(sim=SimulationParams(distance_m={distance}))
+from drake_biped.resources import load_gait
+gait = {gait!r}
+config = (load_gait(gait).override({{"sim.distance_m": {distance}}}) if gait
+          else EpisodeConfig(sim=SimulationParams(distance_m={distance})))
 walks = [run_episode(config) for _ in range({episodes})]
 print(json.dumps({{"rtf": [w.real_time_factor for w in walks], "cmt": [w.cost_of_transport for w in walks]}}))
 """
@@ -44,15 +47,18 @@ import json, sys
 sys.path.insert(0, {bench!r})
 import bench
 from drake_biped.episode import run_episode
-config = bench.config_at(1e-3, {distance})
+from drake_biped.resources import load_gait
+gait = {gait!r}
+config = load_gait(gait).override({{"sim.distance_m": {distance}}}) if gait else bench.config_at(1e-3, {distance})
 ref = run_episode(config, record_trajectory=True)
-times, torques = ref.trajectory["time"], ref.trajectory["actuation"]
+times, torques = ref.trajectory["time"], ref.trajectory["actuation"]  # the torques the plant applied
 end = float(times[-1])
+period = config.sim.update_period_s
 out = {{"plant": [], "direct": [], "empty": []}}
 for _ in range({episodes}):
     out["plant"].append(end / bench.replay(config, times, torques, end)[0])
     out["direct"].append(end / bench.replay_directly(config, times, torques, end)[0])
-    out["empty"].append(end / bench.replay(config, times, torques, end, bench.EmptyUpdate(1e-3))[0])
+    out["empty"].append(end / bench.replay(config, times, torques, end, bench.EmptyUpdate(period))[0])
 print(json.dumps(out))
 """
 
@@ -82,20 +88,23 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--distance", type=float, default=10.0)
     p.add_argument("--learning", type=int, default=0, help="episodes of the learning mix per tree and round (0: none)")
     p.add_argument("--json", type=Path, help="also write every sample here")
+    p.add_argument("--gait", default="", help="a shipped gait to walk at its own step (default: the default gait "
+                   "at 1 ms, as EpisodeConfig() gives it)")
     args = p.parse_args(argv)
     trees = {"before": args.before.resolve(), "after": args.after.resolve()}
     rtf: dict[str, list[float]] = {"before": [], "after": []}
     cmt: dict[str, list[float]] = {"before": [], "after": []}
     ceiling: dict[str, list[float]] = {"plant": [], "direct": [], "empty": []}
     learning: dict[str, list[float]] = {"before": [], "after": []}
-    closed = CLOSED_LOOP.format(episodes=args.episodes, distance=args.distance)
+    closed = CLOSED_LOOP.format(episodes=args.episodes, distance=args.distance, gait=args.gait)
     for r in range(args.rounds):
         order = ("before", "after") if r % 2 == 0 else ("after", "before")
         for name in order:
             got = run_child(trees[name], closed)
             rtf[name] += got["rtf"]
             cmt[name] += got["cmt"]
-        got = run_child(trees["after"], CEILING.format(bench=str(HERE), episodes=args.episodes, distance=args.distance))
+        got = run_child(trees["after"], CEILING.format(bench=str(HERE), episodes=args.episodes, distance=args.distance,
+                                                       gait=args.gait))
         for k in ceiling:
             ceiling[k] += got[k]
         if args.learning:
@@ -105,7 +114,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"round {r + 1}: " + ", ".join(f"{k} {statistics.median(v):.3f}" for k, v in {**rtf, **ceiling}.items()),
               file=sys.stderr)
     med = {k: statistics.median(v) for k, v in {**rtf, **ceiling}.items()}
-    record = {"trees": {k: str(v) for k, v in trees.items()}, "rounds": args.rounds, "episodes": args.episodes,
+    record = {"trees": {k: str(v) for k, v in trees.items()}, "gait": args.gait or "EpisodeConfig()",
+              "rounds": args.rounds, "episodes": args.episodes,
               "distance_m": args.distance, "closed_loop_rtf": rtf, "cost_of_transport": cmt, "ceiling_rtf": ceiling,
               "learning_episodes_per_min": learning, "median": med,
               "after_over_before": med["after"] / med["before"]}
@@ -119,7 +129,7 @@ def main(argv: list[str] | None = None) -> int:
         f"| plant alone, replaying the walk's torques | {len(ceiling['plant'])} | {med['plant']:.3f} | 1.00 |",
         f"| plant alone, stepped by a Python loop (no Simulator) | {len(ceiling['direct'])} | {med['direct']:.3f} | "
         f"{med['direct'] / med['plant']:.2f} |",
-        f"| plant + an empty Python update at 1 kHz | {len(ceiling['empty'])} | {med['empty']:.3f} | "
+        f"| plant + an empty Python update at the control rate | {len(ceiling['empty'])} | {med['empty']:.3f} | "
         f"{med['empty'] / med['plant']:.2f} |",
         f"| closed loop, before ({args.before}) | {len(rtf['before'])} | {med['before']:.3f} | "
         f"{med['before'] / med['plant']:.2f} |",

@@ -46,11 +46,11 @@ def walk_frame(out: Path) -> tuple[Path, str]:
     from drake_biped.analysis.figures import walk_frame as draw
     from drake_biped.episode import run_episode
     from drake_biped.model import body_of_model
-    from drake_biped.params import EpisodeConfig
+    from drake_biped.params import config_of_record
     from drake_biped.versions import compare_with_record
 
     record = json.loads((FULL_RUN / "walk" / "result.json").read_text())
-    config = EpisodeConfig.from_dict(record["config"])
+    config = config_of_record(record["config"])
     result = run_episode(config, record_trajectory=True)
     comparison = compare_with_record(record["cost_of_transport"], result.cost_of_transport, record.get("versions"))
     if not comparison.agrees:

@@ -1,9 +1,13 @@
-"""The paper walker's hip motor against its plant step: the per-update motor (motor_time_constant_s 0, as shipped)
-and motors of a fixed time constant, each walked 110 m without a window at several plant steps; the long-run C_mt
-(first 10 m dropped), the step period's spread, and how often the swing hip's torque changes sign after 3 s (a
-10 m walk with its trajectory recorded):
+"""The paper walker's hip motor against its plant step, each walked 110 m without a window at several plant steps:
+the long-run C_mt (first 10 m dropped), the step period's spread, and how often the swing hip's torque changes sign
+after 3 s (a 10 m walk with its trajectory recorded). The motor solved by the controller (GaitParams.motor_solve
+"controller"), per update (motor_time_constant_s 0) or with a time constant:
 
-    python benchmarks/paper_motor_clock.py --out benchmarks/results/paper-walker/motor-clock --tau-ms 0 2 --h-ms 0.5 0.25 0.125
+    python benchmarks/paper_motor_clock.py --solve controller --out benchmarks/results/paper-walker/motor-clock --tau-ms 0 2 --h-ms 0.5 0.25 0.125
+
+or solved in the plant's step (motor_solve "plant", as shipped) at the given velocity gains:
+
+    python benchmarks/paper_motor_clock.py --solve plant --out benchmarks/results/paper-walker/motor-plant --gain 1000 --h-ms 0.5 0.25 0.125
 
 One JSON file per walk, kept as it finishes: a rerun skips the walks already written."""
 
@@ -38,24 +42,33 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--gait", default="paper")
-    parser.add_argument("--tau-ms", type=float, nargs="+", default=[0.0, 2.0])
+    parser.add_argument("--solve", choices=("plant", "controller"), default="plant")
+    parser.add_argument("--tau-ms", type=float, nargs="+", default=[0.0],
+                        help="the controller's motor's time constants (ms; --solve controller)")
+    parser.add_argument("--gain", type=float, nargs="+", default=[1000.0],
+                        help="the plant's motor's velocity gains (N*m*s/rad; --solve plant)")
     parser.add_argument("--h-ms", type=float, nargs="+", default=[0.5, 0.25, 0.125])
     parser.add_argument("--distance", type=float, default=110.0)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    for tau in args.tau_ms:
+    if args.solve == "controller":
+        motors = [(f"tau{tau:g}ms", {"gait.motor_solve": "controller", "gait.motor_time_constant_s": tau * 1e-3})
+                  for tau in args.tau_ms]
+    else:
+        motors = [(f"gain{gain:g}", {"gait.motor_solve": "plant", "gait.motor_gain_nms": gain}) for gain in args.gain]
+    for name, motor in motors:
         for h in args.h_ms:
-            path = args.out / f"tau{tau:g}ms-h{h:g}ms.json"
+            path = args.out / f"{name}-h{h:g}ms.json"
             if path.exists():
                 continue
-            base = load_gait(args.gait).override({"gait.motor_time_constant_s": tau * 1e-3, "sim.time_step_s": h * 1e-3})
+            base = load_gait(args.gait).override({**motor, "sim.time_step_s": h * 1e-3})
             start = time.time()
             short = run_episode(base, record_trajectory=True)
             flips, saturated = swing_hip_torque_sign_changes(short.trajectory) if short.duration_s > 4.0 else (None, None)
             config = base.override({"sim.distance_m": args.distance, "sim.max_time_s": 6 * args.distance})
             result = run_episode(config)
             lr = None if result.fell else result.long_run()
-            record = {"gait": args.gait, "motor_time_constant_ms": tau, "time_step_ms": h,
+            record = {"gait": args.gait, "motor": motor, "time_step_ms": h,
                       "distance_m": result.distance_m, "fell": result.fell, "cost_of_transport": result.cost_of_transport,
                       "long_run": lr, "sign_changes_per_s_10m": flips, "saturated_part_10m": saturated,
                       "walked_10m": {"fell": short.fell, "distance_m": short.distance_m,

@@ -111,6 +111,11 @@ CONTROLLER_STATE = VectorLayout("controller_state", (
     Field("motor_model_rate_radps", 1, "the hip motor's coordinate rate its model expects at this update, from the "
                                        "last (NaN: none since the roles last swapped)"),
     Field("motor_disturbance_radps", 1, "what that model missed at the last update: the rate measured minus it"),
+    Field("hip_motor_gain_nms", 2, "the plant's hip motors (motor_solve 'plant'), left and right: each hip "
+                                   "actuator's velocity gain over the coming period (MOTOR_OFF_GAIN: a plain torque)"),
+    Field("hip_motor_target_radps", 2, "the hip joint rate each motor drives to over the coming period (rad/s)"),
+    Field("hip_motor_bound_nm", 2, "each hip actuator's torque bound over the coming period, its motor's "
+                                   "feedforward included (0: no torque)"),
 ))
 N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
@@ -124,6 +129,7 @@ POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_w
 PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_rates_radps"), _o("swing_travel_rad")
 REVERSALS, RECENT_REVERSALS = _o("torque_reversals"), _o("recent_reversals_s")
 MOTOR_MODEL_RATE, MOTOR_DISTURBANCE = _o("motor_model_rate_radps"), _o("motor_disturbance_radps")
+MOTOR_GAIN, MOTOR_TARGET, MOTOR_BOUND = _o("hip_motor_gain_nms"), _o("hip_motor_target_radps"), _o("hip_motor_bound_nm")
 del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
@@ -166,6 +172,20 @@ DIVERGED_CODE = 5
 # How much of what the hip motor's model missed at the last update it adds at the next (a low pass: an impact
 # that the model misses for one update does not set the motor ringing).
 MOTOR_DISTURBANCE_GAIN = 0.5
+# The plant's hip motor (GaitParams.motor_solve "plant") is a PD-controlled actuator on each hip, proportional gain
+# 0. Drake fixes which actuators are PD-controlled when the plant first steps, so the hip that is not driven keeps
+# its actuator with this negligible velocity gain (its torque is the feedforward to within 1e-12 N*m per rad/s of
+# its rate's change over a step; the update counts that part too).
+MOTOR_OFF_GAIN = 1e-12
+# The motor's command: the desired state of the plant's actuated joints (q_d, then v_d, in actuator order); only
+# the hips' desired rates are read (the motors have no proportional gain, the other joints no PD).
+MOTOR_COMMAND_SIZE = 12
+
+
+def plant_motor(config: EpisodeConfig) -> bool:
+    """Whether the plant solves the hip motor (GaitParams.hip_drive "motor", motor_solve "plant"): its hips are
+    then PD-controlled actuators, driven through the controller's "motor_command" output."""
+    return config.gait.hip_drive == "motor" and config.gait.motor_solve == "plant"
 
 
 def touchdown_capacity(config: EpisodeConfig) -> int:
@@ -196,6 +216,7 @@ LAW_COPIED = (
     ("ground", "slope_rad", "ground_slope_rad"), ("ground", "level_length_m", "ground_level_length_m"),
     ("sim", "fall_hip_height_m", "fall_hip_height_m"), ("sim", "fall_pitch_rad", "fall_pitch_rad"),
     ("gait", "motor_limit_nm", "motor_limit_nm"), ("gait", "motor_time_constant_s", "motor_time_constant_s"),
+    ("gait", "motor_gain_nms", "motor_gain_nms"),
 )
 _SECTION_TYPES = {"cpg": CpgParams, "gait": GaitParams, "window": TorqueFreeWindow, "ground": Ground,
                   "sim": SimulationParams}
@@ -225,6 +246,8 @@ _DERIVED = {  # the slots computed from the configuration, before and among the 
     "hip_motor": Field("hip_motor", 1, "1 for GaitParams.hip_drive 'motor' (zeta the hip joint's velocity, "
                        "reached each update), 0 for 'servo'", "1"),
     "inter_leg": Field("inter_leg", 1, "1 for GaitParams.hip_joint 'inter_leg', 0 for 'swing'", "1"),
+    "motor_plant": Field("motor_plant", 1, "1 for the hip motor solved in the plant's step (GaitParams.hip_drive "
+                         "'motor', motor_solve 'plant'), else 0", "1"),
 }
 _COPIED = {slot: _copied(section, name, slot) for section, name, slot in LAW_COPIED}
 # The controller's numbers for one episode, a numeric parameter of its Context: every slot with its doc, unit
@@ -238,7 +261,7 @@ LAW = VectorLayout("law", tuple(({**_DERIVED, **_COPIED})[name] for name in (
     "touchdown_min_step_s", "touchdown_height_m", "touchdown_min_advance_m", "touchdown_min_phase",
     "window_start_s", "window_end_s", "window_first_step", "ground_slope_rad", "ground_tan_slope",
     "ground_level_length_m", "fall_hip_height_m", "fall_pitch_rad", "hip_motor", "inter_leg", "motor_limit_nm",
-    "motor_time_constant_s")))
+    "motor_time_constant_s", "motor_plant", "motor_gain_nms")))
 _o = LAW.offset
 L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("update_period_s", "state_lag_s", "alpha", "u_a",
                                                                     "u_eta", "u_r", "kappa"))
@@ -254,7 +277,7 @@ L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_
 L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
 L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
 L_MOTOR, L_INTER_LEG, L_MOTOR_LIMIT = _o("hip_motor"), _o("inter_leg"), _o("motor_limit_nm")
-L_MOTOR_TAU = _o("motor_time_constant_s")
+L_MOTOR_TAU, L_MOTOR_PLANT, L_MOTOR_GAIN = _o("motor_time_constant_s"), _o("motor_plant"), _o("motor_gain_nms")
 del _o
 
 # What the hip motor (GaitParams.hip_drive "motor") reads of the plant's dynamics at each update, computed by
@@ -288,6 +311,7 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     put("ground_tan_slope", math.tan(ground.slope_rad))
     put("hip_motor", 1.0 if g.hip_drive == "motor" else 0.0)
     put("inter_leg", 1.0 if g.hip_joint == "inter_leg" else 0.0)
+    put("motor_plant", 1.0 if plant_motor(config) else 0.0)
     return v
 
 
@@ -337,6 +361,7 @@ def parameter_markdown() -> str:
 
 # The kernel's return code: bits for what the Python side must do after it.
 TOUCHED, FELL, DONE_BIT = 1, 2, 4
+MOTORS = 8  # the plant's hip motors take other gains or bounds from this update on (CpgWalkingController.apply_motors)
 
 # Leg points tuple (kinematics.leg_points_k): the slots the update reads.
 _KNEE_X, _KNEE_Z, _ANKLE_X, _HEEL_X, _HEEL_Z, _TOE_X, _TOE_Z, _THIGH, _FOOT, _HIP_X, _HIP_Z = 0, 1, 2, 4, 5, 6, 7, 8, 10, \
@@ -487,6 +512,18 @@ def motor_coordinate_k(law, v, sw_i: int, st_i: int) -> float:
 
 
 @njit
+def realized_hip_torques_k(s, v, tau) -> None:
+    """The plant's hip motors (motor_solve "plant"): the torque each hip's actuator applied over the period
+    that just ended, into s[TAU + hip], as the plant's step computed it (Drake's PD-controlled actuator at the
+    step's end rate: -gain (rate - target) + feedforward, clipped to the bound); `tau`: the feedforward held."""
+    for leg in range(2):
+        j = 3 * leg  # the hip's torque index (JOINT_NAMES: a leg's hip first)
+        bound = s[MOTOR_BOUND + leg]
+        u = -s[MOTOR_GAIN + leg] * (v[Q_HIP_LEFT + j] - s[MOTOR_TARGET + leg]) + tau[j]
+        s[TAU + j] = 0.0 if bound <= 0.0 else clip(u, bound)
+
+
+@njit
 def motor_model_k(law, dyn, v, dt: float, sw_i: int, st_i: int, others, torso: float) -> tuple:
     """(rate, gain, offset): the model's rate of the motor's coordinate (`motor_coordinate_k`) at the end of
     the update is rate + gain * (swing hip torque - offset), given the other joints' torques `others` (9
@@ -566,6 +603,22 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
     # The hips: the swing hip drives the swing (servo or motor), gated; the stance hip holds the torso.
     hip_limit = body[B_HIP_EFFORT]
     torso = torso_torque_k(law[L_TORSO_KP], law[L_TORSO_KD], law[L_TORSO_PITCH], pitch, pitch_rate)
+    if law[L_MOTOR_PLANT] != 0.0:
+        # The plant's motor: the swing hip's actuator drives its joint's rate to zeta inside the plant's step,
+        # bounded by the motor's limit times the part of the period outside the window (0 inside it); the
+        # stance hip's actuator is a plain torque, the torso's law less the torque the swing hip's actuator
+        # applied over the last period (s[a_sw] holds it: `realized_hip_torques_k`).
+        sw_leg, st_leg = (sw_i - Q_HIP_LEFT) // 3, (st_i - Q_HIP_LEFT) // 3
+        reaction = s[a_sw]
+        s[a_sw] = 0.0
+        s[MOTOR_GAIN + sw_leg] = law[L_MOTOR_GAIN]
+        s[MOTOR_TARGET + sw_leg] = zeta
+        s[MOTOR_BOUND + sw_leg] = (1.0 - free) * min(law[L_MOTOR_LIMIT], hip_limit)
+        s[MOTOR_GAIN + st_leg] = MOTOR_OFF_GAIN
+        s[MOTOR_TARGET + st_leg] = v[st_i]
+        s[MOTOR_BOUND + st_leg] = hip_limit
+        s[a_st] = clip(torso - reaction, hip_limit)
+        return
     if law[L_MOTOR] != 0.0:
         # ODE's motor: the torque that brings the coordinate's rate to zeta by the update's end, from the
         # plant's dynamics and what the last update's model missed (the disturbance: the joint limits' and the
@@ -596,11 +649,12 @@ def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance:
 
 
 @njit
-def control_step(law, body, t: float, x, s, tau, row, dyn) -> int:
+def control_step(law, body, t: float, x, s, tau, row, dyn, command) -> int:
     """One control update at context time t: reads the plant state x (q, v), advances the controller state
     s (CONTROLLER_STATE) in place and writes the torques for the coming period into tau (6). Returns a
-    code of TOUCHED (a touchdown was confirmed: `row` holds its index and its TOUCHDOWN fields), FELL and
-    DONE_BIT. `dyn`: the plant's dynamics at x (DYN_*) where the hip is a motor, else unread."""
+    code of TOUCHED (a touchdown was confirmed: `row` holds its index and its TOUCHDOWN fields), FELL,
+    DONE_BIT and MOTORS. `dyn`: the plant's dynamics at x (DYN_*) where the controller solves the hip motor, else unread;
+    `command`: the plant's motor command (MOTOR_COMMAND_SIZE), written where the plant solves it."""
     dt = law[L_DT]
     now = t + law[L_LAG]  # the time of the plant state read (see "Timing")
     s[STATE_TIME] = now
@@ -610,7 +664,11 @@ def control_step(law, body, t: float, x, s, tau, row, dyn) -> int:
     code = 0
 
     # Work done by the held torques since the last update: tau is constant over the interval,
-    # so its work on each joint is exactly tau * (q_now - q_prev).
+    # so its work on each joint is exactly tau * (q_now - q_prev). The plant's motors: the torque they applied.
+    held_gains = (s[MOTOR_GAIN], s[MOTOR_GAIN + 1])
+    held_bounds = (s[MOTOR_BOUND], s[MOTOR_BOUND + 1])
+    if law[L_MOTOR_PLANT] != 0.0:
+        realized_hip_torques_k(s, v, tau)
     total = 0.0
     for i in range(18):
         total += x[i]
@@ -740,9 +798,11 @@ def control_step(law, body, t: float, x, s, tau, row, dyn) -> int:
     if swap >= 0.0:
         for i in range(TAU, TAU + 6):
             s[i] = swap * s[i] + (1.0 - swap) * new[i]
+        for i in range(MOTOR_GAIN, MOTOR_BOUND + 2):  # the plant's motors too: each hip's by its part
+            s[i] = swap * s[i] + (1.0 - swap) * new[i]
         if crossing:
             for i in range(N_STATE):
-                if i < TAU or i >= TAU + 6:
+                if (i < TAU or i >= TAU + 6) and (i < MOTOR_GAIN or i >= MOTOR_BOUND + 2):
                     s[i] = new[i]
 
     # Fall detection and the end of the episode.
@@ -761,6 +821,11 @@ def control_step(law, body, t: float, x, s, tau, row, dyn) -> int:
         if abs(s[TAU + i] - tau[i]) > REVERSAL_FACTOR * limit:
             reversed_ = True
         tau[i] = s[TAU + i]
+    if law[L_MOTOR_PLANT] != 0.0:
+        for leg in range(2):
+            command[MOTOR_COMMAND_SIZE // 2 + 3 * leg] = s[MOTOR_TARGET + leg]
+            if s[MOTOR_GAIN + leg] != held_gains[leg] or s[MOTOR_BOUND + leg] != held_bounds[leg]:
+                code |= MOTORS
     if reversed_:  # one reversal per update, however many joints jumped
         s[REVERSALS] += 1.0
         for j in range(DIVERGED_REVERSALS - 1, 0, -1):
@@ -815,6 +880,40 @@ class _PlantDynamics:
         dyn[DYN_F : DYN_F + 9] = plant.CalcGravityGeneralizedForces(context) - plant.CalcBiasTerm(context)
 
 
+class _PlantMotors:
+    """The plant's hip actuators as the plant's hip motor drives them (motor_solve "plant"): their velocity gains
+    and effort limits, set between the plant's steps whenever the controller's state changes them. Drake reads
+    an actuator's gains and limit at each step, from the plant's model, not from a Context: so one plant serves
+    one episode at a time, as the episodes' diagrams are used (episode.DiagramCache)."""
+
+    def __init__(self, plant):
+        from pydrake.multibody.tree import PdControllerGains
+
+        self._gains = PdControllerGains
+        self._hips = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices()
+                      if plant.get_joint_actuator(i).joint().name() in (f"{leg}_hip" for leg in LEGS)]
+        names = [a.joint().name() for a in self._hips]
+        if names != [f"{leg}_hip" for leg in LEGS]:
+            raise ValueError(f"the plant's hip actuators: expected {[f'{leg}_hip' for leg in LEGS]}, got {names}")
+        self._applied = [[math.nan, math.nan] for _ in self._hips]
+
+    def apply(self, s: np.ndarray) -> None:
+        for leg, actuator in enumerate(self._hips):
+            gain, bound = s[MOTOR_GAIN + leg], s[MOTOR_BOUND + leg]
+            applied = self._applied[leg]
+            if gain != applied[0]:
+                actuator.set_controller_gains(self._gains(p=0.0, d=gain))
+                applied[0] = gain
+            if bound != applied[1]:
+                # Drake asks for a positive limit: the least double stands for none (its impulse over a step
+                # rounds to zero; the update counts zero)
+                actuator.set_effort_limit(max(bound, MOTOR_NO_TORQUE))
+                applied[1] = bound
+
+
+MOTOR_NO_TORQUE = math.ulp(0.0)
+
+
 class CpgWalkingController(LeafSystem):
     """CPG + torque-free gate + hip PID + knee/ankle/stance logic for the 7-link biped."""
 
@@ -828,6 +927,7 @@ class CpgWalkingController(LeafSystem):
         super().__init__()
         self._dyn = np.zeros(DYN_SIZE)
         self._dynamics = None if plant is None else _PlantDynamics(plant, body)
+        self._motors = None if plant is None else _PlantMotors(plant)
         body = np.asarray(body, dtype=float)
         if body.shape != (BODY.size,):
             raise ValueError(f"body: expected a kinematics.BODY vector of {BODY.size}, got shape {body.shape}")
@@ -849,18 +949,23 @@ class CpgWalkingController(LeafSystem):
         initial[PREV_RATES : PREV_RATES + 2] = math.nan
         initial[RECENT_REVERSALS : RECENT_REVERSALS + DIVERGED_REVERSALS] = -math.inf
         initial[MOTOR_MODEL_RATE] = math.nan
+        initial[MOTOR_GAIN : MOTOR_GAIN + 2] = MOTOR_OFF_GAIN  # the first plant step: no motor acts yet
+        initial[MOTOR_BOUND : MOTOR_BOUND + 2] = body[B_HIP_EFFORT]
         self._torque_group = self.DeclareDiscreteState(6)
         self._state_group = self.DeclareDiscreteState(BasicVector(initial))
         self._touchdown_group = self.DeclareDiscreteState(self._capacity * _TD)
         self.DeclareStateOutputPort("actuation", self._torque_group)
         self.DeclareStateOutputPort("controller_state", self._state_group)
+        self._command_group = self.DeclareDiscreteState(MOTOR_COMMAND_SIZE)
+        self.DeclareStateOutputPort("motor_command", self._command_group)
         self.DeclarePeriodicDiscreteUpdateEvent(config.sim.update_period_s, 0.0, self._update)
 
     @staticmethod
     def structure_key(config: EpisodeConfig) -> tuple:
         """What the system's ports, state sizes and update period are built from."""
         sim = config.sim
-        return (config.ground, sim.time_step_s, sim.update_period_s, sim.max_time_s, config.gait.touchdown_min_step_s)
+        return (config.ground, sim.time_step_s, sim.update_period_s, sim.max_time_s, config.gait.touchdown_min_step_s,
+                plant_motor(config))
 
     def set_episode(self, context, config: EpisodeConfig) -> None:
         """Put the per-episode numbers (CPG, gait, window, fall thresholds) of `config` into this system's
@@ -868,7 +973,7 @@ class CpgWalkingController(LeafSystem):
         must be the one this system was built with."""
         if self.structure_key(config) != self._structure:
             raise ValueError("set_episode: this controller was built for another ground, time step, control "
-                             "period, time limit or minimum step time; build a new diagram")
+                             "period, time limit, minimum step time or hip motor; build a new diagram")
         context.get_mutable_numeric_parameter(self._law_index).SetFromVector(law_vector(config))
 
     def law(self, context) -> np.ndarray:
@@ -882,6 +987,11 @@ class CpgWalkingController(LeafSystem):
     def get_output_port_actuation(self):
         """The six joint torques (N*m, JOINT_NAMES order)."""
         return self.GetOutputPort("actuation")
+
+    def get_output_port_motor_command(self):
+        """The plant's hip motors' command (GaitParams.motor_solve "plant"): the desired state of the plant's
+        actuated joints, MOTOR_COMMAND_SIZE, for its desired-state input; only the hips' rates are read."""
+        return self.GetOutputPort("motor_command")
 
     def get_output_port_controller_state(self):
         """The controller state (CONTROLLER_STATE)."""
@@ -908,6 +1018,18 @@ class CpgWalkingController(LeafSystem):
         n = int(self._row[0])
         if n < self._capacity:
             touchdowns[n * _TD : (n + 1) * _TD] = self._row[1:]
+
+    @property
+    def command_group(self) -> int:
+        """The discrete group of the plant's motor command (the "motor_command" output)."""
+        return int(self._command_group)
+
+    def apply_motors(self, law: np.ndarray, s: np.ndarray) -> None:
+        """Give the plant's hip actuators the gains and bounds the controller state `s` holds for the coming
+        period (motor_solve "plant"; nothing otherwise): call after every update, and once an episode's initial
+        state is set, before the plant's first step."""
+        if law[L_MOTOR_PLANT] != 0.0:
+            self._motors.apply(s)
 
     @property
     def torque_group(self) -> int:
@@ -954,7 +1076,7 @@ class CpgWalkingController(LeafSystem):
     def motor_dynamics(self, law: np.ndarray, x: np.ndarray, s: np.ndarray) -> np.ndarray:
         """The `dyn` argument of `control_step` for the plant state x and controller state s: the plant's
         dynamics where the law's hip is a motor (`_PlantDynamics`), else the unread zeros."""
-        if law[L_MOTOR] == 0.0:
+        if law[L_MOTOR] == 0.0 or law[L_MOTOR_PLANT] != 0.0:
             return self._dyn
         if self._dynamics is None:
             raise ValueError("hip_drive 'motor' needs the plant: build the controller with plant=")
@@ -968,7 +1090,9 @@ class CpgWalkingController(LeafSystem):
         s = discrete_state.get_mutable_value(self._state_group)
         code = control_step(law, self._body, context.get_time(), x, s,
                             discrete_state.get_mutable_value(self._torque_group), self._row,
-                            self.motor_dynamics(law, x, s))
+                            self.motor_dynamics(law, x, s), discrete_state.get_mutable_value(self._command_group))
+        if code & MOTORS:
+            self.apply_motors(law, s)
         if code == 0:
             return None
         if code & TOUCHED:

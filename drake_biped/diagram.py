@@ -13,7 +13,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, VectorLogSink
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_biped.controller import CpgWalkingController
+from drake_biped.controller import MOTOR_OFF_GAIN, CpgWalkingController, plant_motor
 from drake_biped.kinematics import TABLE_I_BODY, LinkMasses, leg_points, masses_of
 from drake_biped.model import add_biped
 from drake_biped.params import EpisodeConfig, Push
@@ -53,6 +53,9 @@ class BipedDiagram:
     state_log: VectorLogSink | None = None
     controller_log: VectorLogSink | None = None
     actuation_log: VectorLogSink | None = None
+    # the actuation log is the plant's net actuation (its hip motors solved in its step), each sample the torques
+    # of the step that ended there; else the controller's output, each sample the torques of the step it begins
+    actuation_applied: bool = False
 
     @property
     def masses(self) -> LinkMasses:
@@ -103,6 +106,15 @@ def build_diagram(
     controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, handles.body, plant))
     builder.Connect(plant.get_state_output_port(), controller.get_input_port_plant_state())
     builder.Connect(controller.get_output_port_actuation(), plant.get_actuation_input_port())
+    if plant_motor(config):  # the hips' actuators are the motor's, inside the plant's step
+        from pydrake.multibody.tree import PdControllerGains
+
+        hips = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices()
+                if plant.get_joint_actuator(i).joint().name().endswith("_hip")]
+        for actuator in hips:
+            actuator.set_controller_gains(PdControllerGains(p=0.0, d=MOTOR_OFF_GAIN))
+        builder.Connect(controller.get_output_port_motor_command(),
+                        plant.get_desired_state_input_port(hips[0].joint().model_instance()))
     if config.push is not None and config.push.force_n != 0.0 and config.push.duration_s > 0.0:
         push = builder.AddNamedSystem("torso_push", TorsoPush(plant, config.push))
         builder.Connect(push.get_output_port(), plant.get_applied_spatial_force_input_port())
@@ -112,7 +124,9 @@ def build_diagram(
         for name, port in (
             ("state_log", plant.get_state_output_port()),
             ("controller_log", controller.get_output_port_controller_state()),
-            ("actuation_log", controller.get_output_port_actuation()),
+            # the torques the plant applied: its motors' included, where it solves the hip motor
+            ("actuation_log", plant.get_net_actuation_output_port() if plant_motor(config)
+             else controller.get_output_port_actuation()),
         ):
             logs[name] = LogVectorOutput(port, builder, period)
             logs[name].set_name(name)
@@ -124,7 +138,7 @@ def build_diagram(
         )
     diagram = builder.Build()
     diagram.set_name("drake_biped")
-    return BipedDiagram(diagram, plant, controller, handles.body, **logs)
+    return BipedDiagram(diagram, plant, controller, handles.body, **logs, actuation_applied=plant_motor(config))
 
 
 def build_replay_diagram(

@@ -207,6 +207,8 @@ def reset_context(parts: BipedDiagram, simulator: Simulator, config: EpisodeConf
     parts.controller.set_episode(ctrl_ctx, config)
     parts.controller.set_initial_state(ctrl_ctx, q0[3:], com_x0, config.sim.distance_m, stance_right, liftoff,
                                       pitch=q0[2], phase=config.initial.cpg_phase_rad)
+    law = parts.controller.law(ctrl_ctx)
+    parts.controller.apply_motors(law, ctrl_ctx.get_discrete_state(parts.controller.state_group).value())
     return plant_ctx, ctrl_ctx, com_x0
 
 
@@ -315,8 +317,12 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     s = ctrl_ctx.get_mutable_discrete_state(controller.state_group).get_mutable_value()
     tau = ctrl_ctx.get_mutable_discrete_state(controller.torque_group).get_mutable_value()
     touchdowns = ctrl_ctx.get_mutable_discrete_state(controller.touchdown_group).get_mutable_value()
+    command = ctrl_ctx.get_mutable_discrete_state(controller.command_group).get_mutable_value()
     law, body, row = controller.kernel_arguments(ctrl_ctx)
-    motor = law[ctl.L_MOTOR] != 0.0  # the hip motor reads the plant's dynamics at each update
+    plant_motor = law[ctl.L_MOTOR_PLANT] != 0.0  # the plant's hip motors take their gains after each update
+    apply_motors = controller.apply_motors
+    commands = controller.command_group
+    motor = law[ctl.L_MOTOR] != 0.0 and not plant_motor  # the controller's motor reads the plant's dynamics
     dyn = controller.motor_dynamics(law, x, s)
     store = controller.store_touchdown
     torques = controller.torque_group
@@ -342,9 +348,13 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
         if k % every == 0:
             if motor:
                 dyn = controller.motor_dynamics(law, x, s)
-            code = ctl.control_step(law, body, t, x, s, tau, row, dyn)
+            code = ctl.control_step(law, body, t, x, s, tau, row, dyn, command)
             mutable(torques)  # the held torques changed: what reads them is out of date
+            if plant_motor:
+                mutable(commands)
             if code:
+                if code & ctl.MOTORS:
+                    apply_motors(law, s)
                 if code & ctl.TOUCHED:
                     store(touchdowns)
                 if code & (ctl.FELL | ctl.DONE_BIT):
@@ -487,11 +497,16 @@ def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
     acts = parts.actuation_log.FindLog(context)
     ctrl = parts.controller_log.FindLog(context).data()
     rows = ctl.CONTROLLER_STATE.rows
+    actuation = acts.data().T.copy()
+    if parts.actuation_applied and len(actuation) > 1:
+        # row k: the torques over [t_k, t_k+1), which the plant reports with the state at t_k+1; the last
+        # period, which the walk did not finish, repeats the one before
+        actuation = np.vstack([actuation[1:], actuation[-1:]])
     return {
         "time": states.sample_times().copy(),
         "positions": states.data()[:9].T.copy(),
         "velocities": states.data()[9:].T.copy(),
-        "actuation": acts.data().T.copy(),
+        "actuation": actuation,
         "cpg_phase": rows(ctrl, "cpg_phase"),
         "torque_free": rows(ctrl, "torque_free"),
         "stance_right": rows(ctrl, "stance_right"),

@@ -238,11 +238,20 @@ class GaitParams(_Validated):
       hip_ki), its torque clipped to the motor's limit: ours, a soft explicit servo;
     - "motor": the paper's words, "the desired Hip angular velocity ... realized by the internal PID controller
       of the ODE": zeta is the desired angular velocity of the hip *joint* (`hip_joint`), reached within each
-      control update as ODE's joint motor reaches it (a velocity constraint bounded by a maximum torque). The
-      torque is the one that brings the joint's velocity to zeta at the update's end, computed from the
-      plant's dynamics (mass matrix, bias and gravity, the stance foot held by its contact, the other joints'
-      torques of the same update), clipped to `motor_limit_nm`. The swing reading's angle reference is not
-      used (ODE's motor has no angle feedback).
+      control update as ODE's joint motor reaches it (a velocity constraint bounded by `motor_limit_nm`),
+      found where `motor_solve` says. The swing reading's angle reference is not used (ODE's motor has no angle
+      feedback).
+    `motor_solve` (motor only) says where its torque is found:
+    - "plant": the motor is a velocity-gain actuator inside the plant's implicit step (Drake's PD-controlled
+      joint actuator, proportional gain 0, derivative gain `motor_gain_nms`, its effort limit the motor's
+      limit), solved together with the contacts and the joint stops, as ODE solves its joint motor with its
+      constraints; the stance hip balances the torso against the torque the motor applied over the last step;
+    - "controller": the torque that brings the joint's velocity to zeta at the update's end, computed by the
+      controller from the plant's dynamics (mass matrix, bias and gravity, the stance foot held by its contact,
+      the other joints' torques of the same update; `motor_time_constant_s`), applied as a plain torque. Its model misses the joint stops and the contact's
+      compliance, so it chatters and its walk moves with the plant step (docs/RESULTS.md).
+    A record naming hip_drive "motor" without motor_solve was written before "plant" existed and is read as
+    "controller", as it walked (`config_of_record`).
     `hip_joint` (motor only): "swing", the swing hip joint, the torso balanced by the stance hip as under the
     servo; or "inter_leg", the one inter-leg angle (swing hip minus stance hip, eq. 15's theta^Hip) driven by the
     hips' differential mode, the torso by their common mode. Inside the torque-free window the swing hip's
@@ -259,10 +268,16 @@ class GaitParams(_Validated):
     hip_drive: str = param("servo", "", 'what realizes zeta at the hip (see GaitParams): "servo" or "motor"')
     hip_joint: str = param("swing", "", 'the motor\'s joint (see GaitParams): "swing" or "inter_leg"')
     motor_limit_nm: float = param(40.0, "N*m", "the hip motor's maximum torque (hip_drive \"motor\")", 0.0, 200.0)
+    motor_solve: str = param(
+        "plant", "", 'where the hip motor\'s torque is found (hip_drive "motor"; see GaitParams): "plant", inside '
+        'the plant\'s implicit step; "controller", by the controller from a model of the plant at each update')
+    motor_gain_nms: float = param(
+        1000.0, "N*m*s/rad", "the hip motor's velocity gain under motor_solve \"plant\" (not printed): its torque "
+        "is -gain (rate - zeta), clipped to the limit, solved with the contacts and the stops (ODE's motor is the "
+        "limit of a large gain)", 1.0, 1e6)
     motor_time_constant_s: float = param(
-        0.0, "s", "the hip motor's time constant (hip_drive \"motor\"; not printed): each update closes the part "
-        "min(1, update period / this) of the rate's miss, so the motor's loop has this bandwidth whatever the step; "
-        "0 closes it within each update, as ODE's motor does at ODE's step", 0.0, 0.1)
+        0.0, "s", "the hip motor's time constant under motor_solve \"controller\" (not printed): each update "
+        "closes the part min(1, update period / this) of the rate's miss; 0 closes it within each update", 0.0, 0.1)
     swing_offset_rad: float = param(
         0.0, "rad", "integrated reading: a constant offset of the swing reference at the end of the half-cycle",
         -1.5, 1.5)
@@ -312,6 +327,7 @@ class GaitParams(_Validated):
     PHASE_READINGS = ("reset", "entrained")
     HIP_DRIVES = ("servo", "motor")
     HIP_JOINTS = ("swing", "inter_leg")
+    MOTOR_SOLVES = ("plant", "controller")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -324,23 +340,33 @@ class GaitParams(_Validated):
         if self.swap_timing not in self.SWAP_TIMINGS:
             raise ParameterError(f"GaitParams.swap_timing = {self.swap_timing!r} is not one of "
                                  f"{list(self.SWAP_TIMINGS)}")
-        for name, allowed in (("hip_drive", self.HIP_DRIVES), ("hip_joint", self.HIP_JOINTS)):
+        for name, allowed in (("hip_drive", self.HIP_DRIVES), ("hip_joint", self.HIP_JOINTS),
+                              ("motor_solve", self.MOTOR_SOLVES)):
             if getattr(self, name) not in allowed:
                 raise ParameterError(f"GaitParams.{name} = {getattr(self, name)!r} is not one of {list(allowed)}")
         if self.hip_drive == "servo" and self.hip_joint != "swing":
             raise ParameterError(f"GaitParams.hip_joint = {self.hip_joint!r} reads the motor's joint: it changes "
                                  "nothing under hip_drive 'servo'")
+        if self.hip_drive == "motor" and self.motor_solve == "plant" and self.hip_joint != "swing":
+            raise ParameterError(f"GaitParams.hip_joint = {self.hip_joint!r} needs motor_solve 'controller': the "
+                                 "plant's motors act on one joint each, not on the difference of two")
 
     # What each reading leaves unread: the controller never reads these fields under it.
     UNREAD_BY_MOTOR = ("swing_reading", "swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain",
                        "placement_velocity_gain")  # the swing reference and its servo: ODE's motor has no angle
-    UNREAD_BY_SERVO = ("motor_limit_nm", "motor_time_constant_s")
+    UNREAD_BY_SERVO = ("motor_limit_nm", "motor_solve", "motor_gain_nms", "motor_time_constant_s")
+    UNREAD_BY_PLANT_MOTOR = ("motor_time_constant_s",)
+    UNREAD_BY_CONTROLLER_MOTOR = ("motor_gain_nms",)
     UNREAD_BY_ENTRAINED = ("touchdown_min_phase",)  # the phase does not follow the steps
 
     def unread(self) -> tuple[str, ...]:
         """The fields this gait's readings leave unread (`hip_drive`, `phase_reading`): a value given to one
         of them changes no walk."""
-        names = self.UNREAD_BY_MOTOR if self.hip_drive == "motor" else self.UNREAD_BY_SERVO
+        if self.hip_drive == "motor":
+            names = self.UNREAD_BY_MOTOR + (self.UNREAD_BY_PLANT_MOTOR if self.motor_solve == "plant"
+                                            else self.UNREAD_BY_CONTROLLER_MOTOR)
+        else:
+            names = self.UNREAD_BY_SERVO
         return names + (self.UNREAD_BY_ENTRAINED if self.phase_reading == "entrained" else ())
 
     def as_walked(self) -> GaitParams:
@@ -666,6 +692,11 @@ class EpisodeConfig(_Validated):
         if self.push is not None and self.push.force_n != 0.0 and self.push.start_s >= self.sim.max_time_s:
             raise ParameterError(f"Push.start_s = {self.push.start_s!r} is at or after the time limit "
                                  f"sim.max_time_s = {self.sim.max_time_s!r}: the push would never act")
+        if (self.gait.hip_drive == "motor" and self.gait.motor_solve == "plant"
+                and self.sim.control_period_s is not None and self.sim.control_period_s != self.sim.time_step_s):
+            raise ParameterError(f"sim.control_period_s = {self.sim.control_period_s!r} with the plant's hip motor "
+                                 "(gait.motor_solve 'plant'): its torque acts at every plant step and is counted "
+                                 "at each update, so the controller must update at the plant step (None)")
 
     def to_dict(self) -> dict[str, Any]:
         """The record of this configuration: each section as its own `to_dict` gives it (the simulation's with
@@ -807,13 +838,18 @@ def config_of_params(data: Any, where: str) -> EpisodeConfig:
 
 
 def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:
-    """The EpisodeConfig of a result record's "config": as `EpisodeConfig.from_dict`, except for two kinds of
+    """The EpisodeConfig of a result record's "config": as `EpisodeConfig.from_dict`, except for three kinds of
     record written before a choice was recorded:
     - no "contact" section: it ran on DRAKE_DEFAULT_CONTACT, and is walked again on it;
     - no "controller_clock" in its "sim", with the control period equal to the plant step: its walk is the same
       under either clock, and it is read with the paper's (the controller at every plant step), so that a
       re-walk at another step refines the controller with the plant, as today's records do. A control period
-      that differs from the step is the fixed-rate loop that record ran on, and is kept."""
+      that differs from the step is the fixed-rate loop that record ran on, and is kept;
+    - a hip motor (gait.hip_drive "motor") and no "motor_solve": the controller solved it (the only motor there
+      was), and it is walked again so."""
+    gait = data.get("gait") if isinstance(data, Mapping) else None
+    if isinstance(gait, Mapping) and gait.get("hip_drive") == "motor" and "motor_solve" not in gait:
+        data = {**data, "gait": {**gait, "motor_solve": "controller"}}
     config = EpisodeConfig.from_dict(data, where)
     if isinstance(data, Mapping) and "contact" not in data:
         config = config.replace(contact=DRAKE_DEFAULT_CONTACT)

@@ -12,7 +12,7 @@ import os
 from importlib import resources
 from pathlib import Path
 
-from drake_biped.params import EpisodeConfig, ParameterError, config_of_params
+from drake_biped.params import EpisodeConfig, ParameterError, config_of_params, config_of_record
 
 __all__ = ["full_run_digest", "gait_about", "gait_compare_window", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
            "shipped_model_file"]
@@ -110,7 +110,7 @@ def load_gait(value: str | Path) -> EpisodeConfig:
     or a result record (a walk's result.json, a grid's best_params.json), whose "config" is used. Its "model"
     is a model file's path (relative to the parameter file) or a record of one (its name, SHA-256 and text).
     A parameter file's fields are held to the rules that join fields (`params.config_of_params`); a record's
-    configuration is read as it was written."""
+    configuration is read as it was walked (`params.config_of_record`)."""
     from drake_biped.records import read_json
 
     path = gait_path(value)
@@ -125,5 +125,5 @@ def load_gait(value: str | Path) -> EpisodeConfig:
         # a model file named in a parameter file: a relative path is relative to the parameter file
         data = {**data, "model": str(Path(path).parent / data["model"])}
     if record:  # written by a run: its window may be a learner's sample, its gait any reading's full record
-        return EpisodeConfig.from_dict(data, f"--params {path}")
+        return config_of_record(data, f"--params {path}")
     return config_of_params(data, f"--params {path}")

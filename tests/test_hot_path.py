@@ -224,3 +224,51 @@ def test_stepping_the_plant_directly_gives_the_simulators_numbers(monkeypatch, c
         assert (a.distance_m, a.duration_s) == (b.distance_m, b.duration_s)
         assert [vars(s) for s in a.steps] == [vars(s) for s in b.steps]
     assert simulator[0].termination == ending
+
+
+def _paper(distance: float = 1.5, **changes) -> EpisodeConfig:
+    from drake_biped.resources import load_gait
+
+    return load_gait("paper").override({"gait.motor_solve": "plant", "sim.distance_m": distance, "sim.max_time_s": 15.0,
+                                        **changes})
+
+
+def test_the_plant_solved_motor_walks_the_simulators_numbers_stepped_directly(monkeypatch):
+    """The paper's walker, its hip motor solved in the plant's step (its actuators' gains and bounds set between
+    steps: controller._PlantMotors), stepped directly and by the Simulator: the same walk to the last bit, with a
+    window (the bound drops to zero and back), across touchdowns (the roles' actuators swap) and with a kick."""
+    from drake_biped import episode
+
+    config = _paper().replace(window=TorqueFreeWindow(0.1, 0.2))
+    assert config.gait.motor_solve == "plant"
+    kick = episode.Kick(0.6017, 0.01, 0.1)
+
+    def walks():
+        return [run_episode(config, cache=None), run_episode(config, cache=None, kick=kick)]
+
+    monkeypatch.setattr(episode, "_DIRECT_STEPS", False)
+    simulator = walks()
+    monkeypatch.setattr(episode, "_DIRECT_STEPS", True)
+    for a, b in zip(simulator, walks()):
+        assert a.termination == b.termination == "distance"
+        assert a.positive_work_j == b.positive_work_j and a.signed_work_j == b.signed_work_j
+        assert (a.distance_m, a.duration_s) == (b.distance_m, b.duration_s)
+        assert [vars(s) for s in a.steps] == [vars(s) for s in b.steps]
+        assert len(a.steps) >= 2
+
+
+def test_a_reused_plant_solved_motor_gives_the_numbers_of_a_fresh_diagram():
+    """The plant's hip actuators keep the gains and bounds the last episode left them (Drake holds them in the
+    model, not in a Context); each episode sets its own before the first step, so an episode on a reused diagram
+    walks as on a fresh one, whatever the one before did (here: ended inside a window, the bound at zero)."""
+    a = _paper(1.0)
+    b = a.replace(window=TorqueFreeWindow(0.05, 5.0, first_step=0)).override({"sim.distance_m": 0.05})
+    cache = DiagramCache()
+    first = run_episode(a, cache=cache)
+    run_episode(b, cache=cache)
+    again = run_episode(a, cache=cache)
+    fresh = run_episode(a, cache=None)
+    assert len(cache) == 1
+    for r in (again, fresh):
+        assert r.to_dict() | {"wall_time_s": 0, "real_time_factor": 0} == first.to_dict() | {
+            "wall_time_s": 0, "real_time_factor": 0}

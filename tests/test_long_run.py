@@ -85,7 +85,7 @@ def test_divergence_is_a_rate_of_reversals_not_a_total(every, diverges):
     for k in range(60):
         if k % every == 0:
             tau[:] = 1e3  # the held torques far from what the update computes: a reversal
-        code = ctl.control_step(law, body, k * 1e-3, x, s, tau, row, np.zeros(ctl.DYN_SIZE))
+        code = ctl.control_step(law, body, k * 1e-3, x, s, tau, row, np.zeros(ctl.DYN_SIZE), np.zeros(ctl.MOTOR_COMMAND_SIZE))
         if code & ctl.FELL:
             fell_at = k
             break

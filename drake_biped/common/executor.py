@@ -277,11 +277,11 @@ def episode_task(config: dict[str, Any], kick: dict[str, float] | None = None) -
     drake_biped.episode.Kick); its result dictionary plus worker bookkeeping."""
     from drake_biped.api_guard import drake_failures_raised
     from drake_biped.episode import Kick, run_episode
-    from drake_biped.params import EpisodeConfig
+    from drake_biped.params import config_of_record
 
     t0 = time.perf_counter()
     with drake_failures_raised("episode on a Dask worker"):  # a SystemExit would end the worker, not the task
-        result = run_episode(EpisodeConfig.from_dict(config), kick=Kick(**kick) if kick else None).to_dict()
+        result = run_episode(config_of_record(config), kick=Kick(**kick) if kick else None).to_dict()
     result["task_wall_time_s"] = time.perf_counter() - t0
     result["worker_peak_rss_mb"] = peak_rss_mb()
     return result

@@ -53,7 +53,13 @@ from drake_biped.paper import (
     LEARNING_TRIALS,
     TABLE_II,
 )
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, parameter_info
+from drake_biped.params import (
+    EpisodeConfig,
+    ParameterError,
+    TorqueFreeWindow,
+    config_of_record,
+    parameter_info,
+)
 from drake_biped.records import read_json, write_atomic
 from drake_biped.versions import versions
 
@@ -97,7 +103,7 @@ class Trial:
         self.index = index
         self.path = out / "trials" / f"trial_{index}.json"
         self.settings = settings
-        self.config = EpisodeConfig.from_dict(settings["config"])
+        self.config = config_of_record(settings["config"])
         start = settings["learner"].get("start_state")
         if self.path.is_file():
             record = self._read_record()
@@ -353,7 +359,7 @@ def check_rewalk_distance(settings: dict[str, Any], distance_m: float) -> None:
     """ParameterError naming --rewalk-distance unless the re-walks' configuration at `distance_m` is one an
     episode takes (it is walked only after the learning)."""
     try:
-        EpisodeConfig.from_dict(settings["config"]).override(
+        config_of_record(settings["config"]).override(
             {"sim.distance_m": distance_m, "sim.max_time_s": max(settings["config"]["sim"]["max_time_s"],
                                                                  6.0 * distance_m)})
     except ParameterError as exc:
@@ -365,7 +371,7 @@ def evaluate(settings: dict[str, Any], trials: list[Trial], client, rewalk_dista
     """Table V's measured rows: the gait without a window, and with each trial's final policy mean; and every
     one of them re-walked with the plant step halved and from 0.95 and 1.05 x the initiation speed
     (`drake_biped.common.walks.rewalk`, each walk kept in the folder `keep` when one is given), as "rewalks"."""
-    base = EpisodeConfig.from_dict(settings["config"])
+    base = config_of_record(settings["config"])
     means = [{"trial": t.index, "t1": float(t.learner.mean[0]), "t2": float(t.learner.mean[1])} for t in trials]
     rewalks = rewalk(base, means, client, distance_m=rewalk_distance_m, keep=keep)
     no_window = _as_measured(rewalks["no_window"]["as_learned"])

@@ -34,7 +34,13 @@ from drake_biped.common.options import (
     print_lines,
 )
 from drake_biped.paper import GARB_MEAN_S, GARB_VARIANCE_S2
-from drake_biped.params import EpisodeConfig, ParameterError, TorqueFreeWindow, check_settings
+from drake_biped.params import (
+    EpisodeConfig,
+    ParameterError,
+    TorqueFreeWindow,
+    check_settings,
+    config_of_record,
+)
 from drake_biped.records import read_json, write_record
 from drake_biped.versions import versions
 
@@ -77,7 +83,7 @@ class CompareSettings:
                                  "window-map with the same --params first)")
         record = read_json(path, "--window-map")
         try:
-            made = EpisodeConfig.from_dict(record["config"])
+            made = config_of_record(record["config"])
         except (KeyError, TypeError) as exc:
             raise ParameterError(f"--window-map {path}: not a window map ({exc})") from None
         mine = self.config.replace(window=TorqueFreeWindow())

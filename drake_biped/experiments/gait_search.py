@@ -50,6 +50,7 @@ from drake_biped.params import (
     ParameterError,
     TorqueFreeWindow,
     check_settings,
+    config_of_record,
     walked_the_distance,
 )
 from drake_biped.records import read_kept_lines, write_text_atomic
@@ -691,7 +692,7 @@ def score(config: EpisodeConfig, windows=ACCEPTANCE_WINDOWS, objective: str = "w
 
 def _child(args) -> tuple[dict, float, dict]:
     parent_dict, seed, sigma, windows, mutations, objective, draws = args
-    child = mutate(EpisodeConfig.from_dict(parent_dict), random.Random(seed), sigma, MUTATION_SETS[mutations])
+    child = mutate(config_of_record(parent_dict), random.Random(seed), sigma, MUTATION_SETS[mutations])
     value, detail = score(child, windows, objective, draws)
     return child.to_dict(), value, detail
 
@@ -846,7 +847,7 @@ def decode(start: EpisodeConfig, mutations, x, sigma: float = 0.1) -> EpisodeCon
 
 def _scored(args) -> tuple[float, dict]:
     config_dict, windows, objective, draws = args
-    return score(EpisodeConfig.from_dict(config_dict), windows, objective, draws)
+    return score(config_of_record(config_dict), windows, objective, draws)
 
 
 def run_cmaes(settings: GaitSearchSettings, out: Path, client=None, progress: bool = True) -> dict[str, Any]:

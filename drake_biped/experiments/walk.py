@@ -32,6 +32,7 @@ from drake_biped.params import (
     TorqueFreeWindow,
     check_settings,
     check_window_given,
+    config_of_record,
     walked_the_distance,
 )
 from drake_biped.records import warn, write_text_atomic
@@ -231,7 +232,7 @@ def record_comparison_lines(params, config: EpisodeConfig, result) -> list[str]:
     if not (isinstance(record, dict) and isinstance(record.get("config"), dict)
             and isinstance(record.get("cost_of_transport"), (int, float))):
         return []
-    if EpisodeConfig.from_dict(record["config"]).to_dict() != config.to_dict():
+    if config_of_record(record["config"]).to_dict() != config.to_dict():
         return [f"record {path}: not compared, this walk's configuration is not the record's (options changed it)"]
     comparison = compare_with_record(record["cost_of_transport"], result.cost_of_transport, record.get("versions"))
     return [f"record {path}: {comparison.text}"]

@@ -32,6 +32,7 @@ from drake_biped.params import (
     ParameterError,
     TorqueFreeWindow,
     check_settings,
+    config_of_record,
     walked_the_distance,
 )
 from drake_biped.records import read_kept_lines, write_text_atomic
@@ -94,7 +95,7 @@ def window_row(config: dict[str, Any]) -> dict[str, Any]:
     """One episode of an EpisodeConfig dictionary, summarised as a row of the map (runs on a worker)."""
     from drake_biped.episode import run_episode
 
-    c = EpisodeConfig.from_dict(config)
+    c = config_of_record(config)
     r = run_episode(c)
     hip = sum(v for k, v in r.positive_work_j.items() if k.endswith("hip"))
     return {
