@@ -2,10 +2,11 @@
 the ceiling a Python controller can reach.
 
     python benchmarks/compare_rtf.py BEFORE_TREE AFTER_TREE [--rounds 5] [--episodes 3] [--distance 10]
-                                     [--learning 40] [--gait NAME]
+                                     [--learning 40] [--gait NAME] [--after-gait NAME_OR_FILE]
 
 Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) that walks the default gait (or
-the shipped gait `--gait`, at its own step) `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
+the shipped gait `--gait`, at its own step; the after tree `--after-gait` where given, a name or a parameter
+file its tree reads) `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
 Simulator.AdvanceTo; the first walk of a process also builds its diagram, which is not timed) and its C_mt.
 In the same round, a process of the after tree measures the ceiling on the same walk: the plant alone
 replaying the walk's logged torques (no Python during the simulation), the same plant stepped by a Python
@@ -90,21 +91,26 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", type=Path, help="also write every sample here")
     p.add_argument("--gait", default="", help="a shipped gait to walk at its own step (default: the default gait "
                    "at 1 ms, as EpisodeConfig() gives it)")
+    p.add_argument("--after-gait", default=None, help="what the after tree walks instead (a shipped name or a "
+                   "parameter file), and its ceiling replays: a reading the before tree does not have")
     args = p.parse_args(argv)
     trees = {"before": args.before.resolve(), "after": args.after.resolve()}
     rtf: dict[str, list[float]] = {"before": [], "after": []}
     cmt: dict[str, list[float]] = {"before": [], "after": []}
     ceiling: dict[str, list[float]] = {"plant": [], "direct": [], "empty": []}
     learning: dict[str, list[float]] = {"before": [], "after": []}
-    closed = CLOSED_LOOP.format(episodes=args.episodes, distance=args.distance, gait=args.gait)
+    after_gait = args.gait if args.after_gait is None else str(Path(args.after_gait).resolve()) \
+        if Path(args.after_gait).exists() else args.after_gait
+    closed = {name: CLOSED_LOOP.format(episodes=args.episodes, distance=args.distance,
+                                       gait=after_gait if name == "after" else args.gait) for name in trees}
     for r in range(args.rounds):
         order = ("before", "after") if r % 2 == 0 else ("after", "before")
         for name in order:
-            got = run_child(trees[name], closed)
+            got = run_child(trees[name], closed[name])
             rtf[name] += got["rtf"]
             cmt[name] += got["cmt"]
         got = run_child(trees["after"], CEILING.format(bench=str(HERE), episodes=args.episodes, distance=args.distance,
-                                                       gait=args.gait))
+                                                       gait=after_gait))
         for k in ceiling:
             ceiling[k] += got[k]
         if args.learning:
@@ -115,6 +121,7 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
     med = {k: statistics.median(v) for k, v in {**rtf, **ceiling}.items()}
     record = {"trees": {k: str(v) for k, v in trees.items()}, "gait": args.gait or "EpisodeConfig()",
+              "after_gait": after_gait or args.gait or "EpisodeConfig()",
               "rounds": args.rounds, "episodes": args.episodes,
               "distance_m": args.distance, "closed_loop_rtf": rtf, "cost_of_transport": cmt, "ceiling_rtf": ceiling,
               "learning_episodes_per_min": learning, "median": med,

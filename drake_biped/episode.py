@@ -321,7 +321,6 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     law, body, row = controller.kernel_arguments(ctrl_ctx)
     plant_motor = law[ctl.L_MOTOR_PLANT] != 0.0  # the plant's hip motors take their gains after each update
     apply_motors = controller.apply_motors
-    commands = controller.command_group
     motor = law[ctl.L_MOTOR] != 0.0 and not plant_motor  # the controller's motor reads the plant's dynamics
     dyn = controller.motor_dynamics(law, x, s)
     store = controller.store_touchdown
@@ -349,9 +348,11 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
             if motor:
                 dyn = controller.motor_dynamics(law, x, s)
             code = ctl.control_step(law, body, t, x, s, tau, row, dyn, command)
-            mutable(torques)  # the held torques changed: what reads them is out of date
+            # the held torques changed (and the motors' command): what reads them is out of date
             if plant_motor:
-                mutable(commands)
+                mutable()  # every group, in one call
+            else:
+                mutable(torques)
             if code:
                 if code & ctl.MOTORS:
                     apply_motors(law, s)
