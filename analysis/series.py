@@ -74,3 +74,14 @@ def sign_changes_per_s(times, values, segment=None) -> float:
                          f"(at least 2, over a positive time), got shapes {t.shape}, {x.shape}, {same.shape}")
     change = (np.sign(x[1:]) * np.sign(x[:-1]) < 0) & (same[1:] == same[:-1])
     return float(change.sum() / (t[-1] - t[0]))
+
+
+def swing_hip_sign_changes_per_s(trajectory, after_s: float = 3.0) -> float:
+    """How often the swing hip's torque changes sign in a recorded walk (`EpisodeResult.trajectory`), from
+    `after_s` on, per second (`sign_changes_per_s`, the stance leg as the segment: a role swap is no change): the
+    hip motor's chatter. ValueError for a walk that ends before `after_s` plus one update."""
+    t, act, right = trajectory["time"], trajectory["actuation"], trajectory["stance_right"] > 0.5
+    names = [str(n) for n in trajectory["actuator_names"]]
+    tau = np.where(right, act[:, names.index("left_hip_motor")], act[:, names.index("right_hip_motor")])
+    keep = t >= after_s
+    return sign_changes_per_s(t[keep], tau[keep], right[keep])

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_biped.analysis.series import sign_changes_per_s
+from drake_biped.analysis.series import swing_hip_sign_changes_per_s
 from drake_biped.episode import run_episode
 from drake_biped.model import joint_index
 from drake_biped.resources import load_gait
@@ -29,13 +29,11 @@ from drake_biped.versions import versions
 
 def swing_hip_torque_sign_changes(trajectory: dict, after_s: float = 3.0) -> tuple[float, float]:
     """How often the swing hip's applied torque changes sign (per second, from `after_s`: analysis.series.
-    sign_changes_per_s, a role swap being no change), and the part of the updates it sits within 1 % of its
-    largest (the motor's limit when it saturates)."""
+    swing_hip_sign_changes_per_s), and the part of the updates it sits within 1 % of its largest (the motor's
+    limit when it saturates)."""
     t, act, right = trajectory["time"], trajectory["actuation"], trajectory["stance_right"] > 0.5
-    tau = np.where(right, act[:, joint_index("left", "hip")], act[:, joint_index("right", "hip")])
-    keep = t >= after_s
-    tau, t, right = tau[keep], t[keep], right[keep]
-    return sign_changes_per_s(t, tau, right), float(np.mean(np.abs(tau) >= 0.99 * np.abs(tau).max()))
+    tau = np.where(right, act[:, joint_index("left", "hip")], act[:, joint_index("right", "hip")])[t >= after_s]
+    return swing_hip_sign_changes_per_s(trajectory, after_s), float(np.mean(np.abs(tau) >= 0.99 * np.abs(tau).max()))
 
 
 def main() -> None:

@@ -203,15 +203,11 @@ def test_a_controller_motor_of_fixed_time_constant_chatters_less_and_one_of_an_u
     T at or under the update period is the per-update motor to the last digit; a 2 ms motor's swing-hip torque
     changes sign far less often on the paper's walker (at 10 m: 93 against 179 times a second, RESULTS "The
     motor's bandwidth")."""
-    from drake_biped.analysis.series import sign_changes_per_s
-    from drake_biped.model import joint_index
+    from drake_biped.analysis.series import swing_hip_sign_changes_per_s
     from drake_biped.resources import load_gait
 
     def changes(trajectory) -> float:
-        t, act, right = trajectory["time"], trajectory["actuation"], trajectory["stance_right"] > 0.5
-        tau = np.where(right, act[:, joint_index("left", "hip")], act[:, joint_index("right", "hip")])
-        keep = t >= 2.0
-        return sign_changes_per_s(t[keep], tau[keep], right[keep])
+        return swing_hip_sign_changes_per_s(trajectory, after_s=2.0)
 
     base = load_gait("paper").override({"gait.motor_solve": "controller", "sim.distance_m": 4.0})
     shipped = run_episode(base, record_trajectory=True)
@@ -250,7 +246,7 @@ def test_the_plant_solved_motor_converges_where_the_controllers_did_not():
     the motor computed by the controller from a model that misses the stops and the contact's compliance. On the
     10 m walk from the paper's initiation, its C_mt at 0.5 ms is 1 % above its 0.125 ms walk, and its swing hip's
     torque changes sign over 150 times a second; solved in the plant's step, within 0.5 % and under 50 times."""
-    from drake_biped.analysis.series import sign_changes_per_s
+    from drake_biped.analysis.series import swing_hip_sign_changes_per_s
     from drake_biped.resources import load_gait
 
     def walk(solve, h):
@@ -259,15 +255,10 @@ def test_the_plant_solved_motor_converges_where_the_controllers_did_not():
         assert not r.fell
         return r
 
-    def changes(trajectory) -> float:
-        t, act, right = trajectory["time"], trajectory["actuation"], trajectory["stance_right"] > 0.5
-        tau = np.where(right, act[:, 0], act[:, 3])
-        keep = t >= 3.0
-        return sign_changes_per_s(t[keep], tau[keep], right[keep])
-
     gap = {}
     for solve in ("controller", "plant"):
         coarse, fine = walk(solve, 5e-4), walk(solve, 1.25e-4)
-        gap[solve] = (coarse.cost_of_transport / fine.cost_of_transport - 1.0, changes(coarse.trajectory))
+        gap[solve] = (coarse.cost_of_transport / fine.cost_of_transport - 1.0,
+                      swing_hip_sign_changes_per_s(coarse.trajectory))
     assert abs(gap["controller"][0]) > 0.01 and gap["controller"][1] > 150, gap
     assert abs(gap["plant"][0]) < 0.005 and gap["plant"][1] < 50, gap
