@@ -9,9 +9,14 @@ when the centre of mass has walked the distance. The torques are held in a discr
 with DeclareStateOutputPort, so the plant reads them at its own rate without calling back into Python.
 
 Input port:  "plant_state" (18): MultibodyPlant state q (9), v (9).
-Output ports: "actuation" (6): joint torques (N*m), JOINT_NAMES order, applied by the plant.
+Output ports: "actuation" (6): joint torques (N*m), JOINT_NAMES order, applied by the plant (where the plant
+              solves the hip motor, GaitParams.motor_solve "plant", the hips' feedforward: their PD-controlled
+              actuators add the motor's torque).
               "controller_state" (CONTROLLER_STATE): phase, roles, step bookkeeping, work integrals, fall flag.
-Discrete groups: actuation (6), controller state (CONTROLLER_STATE), touchdowns (capacity x TOUCHDOWN).
+              "motor_command" (MOTOR_COMMAND_SIZE): the desired state of the plant's actuated joints, of which
+              the hip motors read their rates (connected only where the plant solves the motor).
+Discrete groups: actuation (6), controller state (CONTROLLER_STATE), touchdowns (capacity x TOUCHDOWN), motor
+command (MOTOR_COMMAND_SIZE).
 Both layouts are declared once below; outside the update, read them by name (`CONTROLLER_STATE.view`).
 
 Timing: the plant's output ports are sampled (Drake's default for a discrete plant), so the state the
