@@ -121,6 +121,9 @@ CONTROLLER_STATE = VectorLayout("controller_state", (
     Field("hip_motor_target_radps", 2, "the hip joint rate each motor drives to over the coming period (rad/s)"),
     Field("hip_motor_bound_nm", 2, "each hip actuator's torque bound over the coming period, its motor's "
                                    "feedforward included (0: no torque)"),
+    Field("positive_work_by_role_j", 6, "integrals of max(tau * omega, 0) dt by the joint's role over each period, "
+                                        "model.ROLES order (J)"),
+    Field("negative_work_by_role_j", 6, "integrals of min(tau * omega, 0) dt by role, model.ROLES order (J)"),
 ))
 N_STATE = CONTROLLER_STATE.size
 _o = CONTROLLER_STATE.offset
@@ -135,6 +138,7 @@ PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_
 REVERSALS, RECENT_REVERSALS = _o("torque_reversals"), _o("recent_reversals_s")
 MOTOR_MODEL_RATE, MOTOR_DISTURBANCE = _o("motor_model_rate_radps"), _o("motor_disturbance_radps")
 MOTOR_GAIN, MOTOR_TARGET, MOTOR_BOUND = _o("hip_motor_gain_nms"), _o("hip_motor_target_radps"), _o("hip_motor_bound_nm")
+ROLE_POSITIVE, ROLE_NEGATIVE = _o("positive_work_by_role_j"), _o("negative_work_by_role_j")
 del _o
 
 # One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
@@ -677,11 +681,18 @@ def control_step(law, body, t: float, x, s, tau, row, dyn, command) -> int:
     total = 0.0
     for i in range(18):
         total += x[i]
+    # The work by role (model.ROLES): each period for the roles the legs held when it began (a period the roles swap
+    # inside counts for the roles before the swap).
+    held_right = s[STANCE_RIGHT] > 0.5
     for i in range(6):
         w = s[TAU + i] * (q[3 + i] - q_prev[i])
         s[SIGNED_WORK + i] += w
+        role = 2 * (i % 3) + (1 if (i >= 3) == held_right else 0)  # ROLES: swing, then stance, of each joint
         if w > 0.0:
             s[POSITIVE_WORK + i] += w
+            s[ROLE_POSITIVE + role] += w
+        else:
+            s[ROLE_NEGATIVE + role] += w
         s[Q_PREV + i] = q[3 + i]
 
     if not math.isfinite(total):  # a NaN or an infinity anywhere makes the sum non-finite

@@ -22,7 +22,7 @@ from drake_biped.analysis.long_run import BATCHES, TRANSIENT_M, long_run_cost
 from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
-from drake_biped.model import JOINT_NAMES, joint_index
+from drake_biped.model import JOINT_NAMES, ROLES, joint_index
 from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, SimulationParams
 from drake_biped.records import atomic_file, write_text_atomic
 from drake_biped.versions import versions
@@ -74,6 +74,10 @@ class EpisodeResult:
     seed: int
     versions: dict[str, str | None]
     trajectory: dict[str, np.ndarray] | None = field(default=None, repr=False)
+    # {role: {"positive_j", "negative_j"}} over the whole episode, roles as model.ROLES (swing hip, stance hip,
+    # swing knee, ...), each control period counted for the roles held when it began; None in a record written
+    # before it was kept
+    work_by_role: dict[str, dict[str, float]] | None = None
 
     @property
     def total_positive_work_j(self) -> float:
@@ -438,6 +442,8 @@ def run_episode(
     work = s.signed_work_j
     signed = {n: float(work[i]) for i, n in enumerate(JOINT_NAMES)}
     signed["total"] = float(sum(work))
+    by_role = {role: {"positive_j": float(p), "negative_j": float(n)}
+               for role, p, n in zip(ROLES, s.positive_work_by_role_j, s.negative_work_by_role_j)}
 
     steps = step_records(parts.controller.touchdowns(ctrl_ctx))
     if len(steps) >= 3:
@@ -473,6 +479,7 @@ def run_episode(
         seed=config.seed,
         versions=versions(),
         trajectory=trajectory,
+        work_by_role=by_role,
     )
 
 
@@ -514,6 +521,8 @@ def _trajectory(parts: BipedDiagram, context) -> dict[str, np.ndarray]:
         "contact_right": rows(ctrl, "contact_right"),
         "step_start": rows(ctrl, "step_start_s"),
         "positive_work": rows(ctrl, "positive_work_j"),
+        "positive_work_by_role": rows(ctrl, "positive_work_by_role_j"),  # columns: model.ROLES
+        "negative_work_by_role": rows(ctrl, "negative_work_by_role_j"),
         "position_names": np.array(["x", "z", "pitch", *JOINT_NAMES]),
         "actuator_names": np.array([f"{n}_motor" for n in JOINT_NAMES]),
     }

@@ -73,6 +73,8 @@ if not any(isinstance(f, _DropHalfSpaceWarning) for f in logging.getLogger("drak
 LEGS = ("left", "right")
 JOINTS_OF_A_LEG = ("hip", "knee", "ankle")
 JOINT_NAMES = tuple(f"{leg}_{joint}" for leg in LEGS for joint in JOINTS_OF_A_LEG)
+# The joints by their leg's role: each joint of the swing leg, then the same joint of the stance leg.
+ROLES = tuple(f"{role}_{joint}" for joint in JOINTS_OF_A_LEG for role in ("swing", "stance"))
 
 
 def joint_index(leg: str, joint: str) -> int:

@@ -78,11 +78,11 @@ def test_shipped_gaits_load_by_name_or_path(tmp_path):
 def test_controller_state_is_read_by_name():
     from drake_biped.controller import CONTROLLER_STATE, N_STATE, POSITIVE_WORK, TAU
 
-    assert N_STATE == CONTROLLER_STATE.size == 56
+    assert N_STATE == CONTROLLER_STATE.size == 68
     assert CONTROLLER_STATE.slice("torques_nm") == slice(TAU, TAU + 6)
     vector = np.arange(N_STATE, dtype=float)
     view = CONTROLLER_STATE.view(vector)
-    assert view.cpg_phase == 0.0 and view.torque_reversals == N_STATE - 14 and view.swing_travel_rad == N_STATE - 15
+    assert view.cpg_phase == 0.0 and view.torque_reversals == N_STATE - 26 and view.swing_travel_rad == N_STATE - 27
     np.testing.assert_array_equal(view.positive_work_j, vector[POSITIVE_WORK:POSITIVE_WORK + 6])
     log = np.vstack([vector, vector + 100]).T  # two samples, as VectorLog.data() holds them
     np.testing.assert_array_equal(CONTROLLER_STATE.rows(log, "cpg_phase"), [0.0, 100.0])

@@ -42,6 +42,7 @@ LAYERS = {
     "drake_biped.analysis.bifurcation_report": RECORDS,
     "drake_biped.analysis.push_margin_report": RECORDS,
     "drake_biped.analysis.floquet_report": RECORDS,
+    "drake_biped.analysis.energy": RECORDS,
     "drake_biped.analysis.reproduce_report": RECORDS,
     "drake_biped.experiments.rewalk": EXPERIMENTS,
     "drake_biped.learners.garb": EXPERIMENTS,

@@ -214,7 +214,7 @@ def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client)
     from drake_biped.experiments import compare_learners, window_map
 
     config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
-    window_map.run(window_map.WindowMapSettings(config, t1_max_s=0.1, t2_max_s=0.3), tmp_path / "map", client,
+    window_map.run(window_map.WindowMapSettings(config, t1_max_s=0.1, t2_max_s=0.3, t1_step_s=0.1, t2_step_s=0.1), tmp_path / "map", client,
                    progress=False)
     from drake_biped.common import learning_runs as learning
 

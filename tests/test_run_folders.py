@@ -99,13 +99,19 @@ def test_walk_into_another_walks_folder_is_refused_before_any_work(tmp_path, cap
 def test_a_window_map_beyond_its_limit_is_refused_before_any_work(tmp_path, capsys):
     from drake_biped.experiments.window_map import MAX_WINDOWS, WindowMapSettings
 
+    grid = {"t1_max_s": 0.6, "t2_max_s": 0.9, "min_length_s": 0.1}
     with pytest.raises(ParameterError, match=r"gives 301,101 windows, more than the limit of 20,000"):
-        WindowMapSettings(t1_step_s=0.001, t2_step_s=0.001)
-    assert WindowMapSettings(t1_step_s=0.001, t2_step_s=0.001, force=True).window_count() == 301_101 > MAX_WINDOWS
-    assert WindowMapSettings().window_count() == len(WindowMapSettings().windows())
-    with pytest.raises(SystemExit) as e:
-        main(["window-map", "--step", "0.001", "--distance", "0.3", "--out", str(tmp_path / "m")])
-    assert e.value.code == 2 and "301,101 windows" in capsys.readouterr().err
+        WindowMapSettings(t1_step_s=0.001, t2_step_s=0.001, **grid)
+    assert WindowMapSettings(t1_step_s=0.001, t2_step_s=0.001, force=True, **grid).window_count() == 301_101 > MAX_WINDOWS
+    placed = WindowMapSettings().for_step_period(0.9)  # the gait's own grid: t1 to T, t2 to 1.5 T, steps T / 10
+    assert (placed.t1_max_s, placed.t2_max_s, placed.t1_step_s, placed.t2_step_s) == (0.9, 1.35, 0.09, 0.09)
+    assert placed.window_count() == len(placed.windows())
+    assert max(t1 for t1, _ in placed.windows()) == pytest.approx(0.9)
+    assert max(t2 for _, t2 in placed.windows()) == pytest.approx(1.35)
+    with pytest.raises(SystemExit) as e:  # a grid given whole is refused before any work
+        main(["window-map", "--step", "0.001", "--t1-max", "0.6", "--t2-max", "0.9", "--distance", "0.3",
+              "--out", str(tmp_path / "m")])
+    assert e.value.code == 2 and "360,600 windows" in capsys.readouterr().err
     assert not (tmp_path / "m").exists()
 
 
@@ -116,7 +122,8 @@ def test_a_window_map_keeps_every_finished_episode_and_sets_a_damaged_log_aside(
     run again, and the map is the same."""
     from drake_biped.experiments.window_map import WindowMapSettings, run
 
-    settings = WindowMapSettings(EpisodeConfig().override({"sim.distance_m": 0.3}), t1_max_s=0.1, t2_max_s=0.3)
+    settings = WindowMapSettings(EpisodeConfig().override({"sim.distance_m": 0.3}), t1_max_s=0.1, t2_max_s=0.3,
+                                 t1_step_s=0.1, t2_step_s=0.1)
     out = tmp_path / "wm"
     first = run(settings, out, client, progress=False)
     keep = out / "episodes.jsonl"
