@@ -591,9 +591,10 @@ def test_a_search_over_gains_its_gait_leaves_unread_is_refused_naming_them_and_t
 
 
 def test_converged_objective_scores_the_spread_and_the_chatter_at_the_walks_own_step(monkeypatch):
-    """Fake walks: while a robust check fails, the robust score - 2; once all hold, -(s + c) / 2 with s the step
-    period's sd over 1 ms less 1 and c the swing hip's sign changes a second over 20 less 1, each capped at 1:
-    0.5 ms and 10 a second score 0, 2 ms and 30 a second -(1 + 0.5) / 2."""
+    """Fake walks: while a robust check fails, the robust score - 2; once all hold, -(s + c + m) / 3 with s the
+    step period's sd over 1 ms less 1, c the swing hip's sign changes a second over 20 less 1 and m the half step's
+    C_mt change over 0.5 % less 1, each capped at 1: 0.5 ms, 10 a second and 0.2 % score 0; 2 ms, 30 a second and
+    0.75 % -(1 + 0.5 + 0.5) / 3."""
     import types
 
     from drake_biped import episode
@@ -607,13 +608,15 @@ def test_converged_objective_scores_the_spread_and_the_chatter_at_the_walks_own_
             "actuator_names": np.array([f"{leg}_{j}_motor" for leg in ("left", "right") for j in ("hip", "knee", "ankle")])})
 
     config = EpisodeConfig(sim=SimulationParams(distance_m=100.0))
-    for robust, spread, changes, expected in ((0.0, 5e-4, 10.0, 0.0), (0.0, 2e-3, 30.0, -0.75),
-                                              (-0.3, 5e-4, 10.0, -2.3)):
+    for robust, spread, changes, moved, expected in ((0.0, 5e-4, 10.0, 0.002, 0.0),
+                                                     (0.0, 2e-3, 30.0, -0.0075, -2.0 / 3.0),
+                                                     (-0.3, 5e-4, 10.0, 0.002, -2.3)):
         base = {"walked": True, "cost_of_transport": 0.2, "distance_m": 100.0, "reward": 5.0,
                 "step_period_std_s": spread}
         monkeypatch.setattr(gait_search, "_walk", lambda c, base=base: base)
-        monkeypatch.setattr(gait_search, "_robust_score", lambda c, b, r=robust: (r, {"checks": {}}))
+        monkeypatch.setattr(gait_search, "_robust_score",
+                            lambda c, b, r=robust, m=moved: (r, {"checks": {}, "half_step_cmt_change": m}))
         monkeypatch.setattr(episode, "run_episode", lambda c, record_trajectory=False, n=changes: recorded(n))
         value, detail = gait_search.score(config, objective="converged")
-        assert value == pytest.approx(expected, abs=0.01), (robust, spread, changes, detail)
+        assert value == pytest.approx(expected, abs=0.01), (robust, spread, changes, moved, detail)
     assert gait_search.OBJECTIVES["converged"].maximum == 0.0

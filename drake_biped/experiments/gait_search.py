@@ -133,8 +133,10 @@ MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": N
 ROBUST_CHECKS = ("half_step", "speed_0.95", "speed_1.05", "push_forward", "push_backward")
 ROBUST_CMT_CHANGE = 0.02
 # The "converged" objective's targets at the walk's own plant step: the step period's spread after the transient,
-# and how often the swing hip's torque changes sign on a 10 m walk after CONVERGED_AFTER_S (the motor's chatter).
+# how often the swing hip's torque changes sign on a 10 m walk after CONVERGED_AFTER_S (the motor's chatter), and
+# the half step's relative C_mt change (the robust objective allows ROBUST_CMT_CHANGE).
 CONVERGED_STEP_SD_S, CONVERGED_SIGN_CHANGES, CONVERGED_AFTER_S = 1e-3, 20.0, 3.0
+CONVERGED_CMT_CHANGE = 0.005
 # Hip off from t1 until the swing foot lands (t2 beyond any step): a gait that coasts to touchdown.
 COAST_WINDOWS = ((0.2, 5.0), (0.3, 5.0), (0.4, 5.0), (0.5, 5.0))
 # The "hold" objective's windows (t1 across the end of the step, t2 past any step) and how far below the best
@@ -362,9 +364,14 @@ def _converged_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
         return -2.0, detail
     spread = base["step_period_std_s"]
     changes = swing_hip_sign_changes_per_s(short.trajectory, CONVERGED_AFTER_S)
-    value = -0.5 * (min(1.0, max(0.0, spread / CONVERGED_STEP_SD_S - 1.0))
-                    + min(1.0, max(0.0, changes / CONVERGED_SIGN_CHANGES - 1.0)))
-    detail["converged"] = {"step_period_std_s": spread, "sign_changes_per_s": changes}
+    moved = abs(detail["half_step_cmt_change"])
+
+    def excess(value: float, target: float) -> float:
+        return min(1.0, max(0.0, value / target - 1.0))
+
+    value = -(excess(spread, CONVERGED_STEP_SD_S) + excess(changes, CONVERGED_SIGN_CHANGES)
+              + excess(moved, CONVERGED_CMT_CHANGE)) / 3.0
+    detail["converged"] = {"step_period_std_s": spread, "sign_changes_per_s": changes, "half_step_cmt_change": moved}
     return value, detail
 
 
@@ -691,7 +698,7 @@ OBJECTIVES: dict[str, Objective] = {
     "floquet": Objective(_of_base(_orbit_score), False, "(1 - rho) / (1 + rho), rho the spectral radius of the gait's period-1 orbit (`common.floquet_runs.orbit_radius`: Newton and one central-difference Jacobian on the mid-stance step map): positive once the orbit attracts; (score - 1) / 2 when Newton leaves a residual above 1e-3; FLOQUET_UNDEFINED (-1) when a perturbed step falls."),
     "landscape": Objective(_of_base(_landscape_score), False, "The same from a coarse window map (LANDSCAPE_WINDOWS, 0.2 s apart up to t1 0.8 s, t2 1.2 s) through `analysis.landscape`: the expected reward's gain at (0.5, 0.5) with variance 0.04, plus half the best policy mean's gain up to BEST_GAIN_CAP, minus PUSH_PENALTY for each of the +-PUSH_FORCE_N pushes (stability's, without a window) the gait does not walk through."),
     "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold.", 0.0),
-    "converged": Objective(_of_base(_converged_score), True, 'The "robust" objective first (while a check fails, its score - 2), then how far the walk is from converged at its own plant step: -(s + c) / 2, s the excess of the step period\'s sd (the walk without a window, after the first 10 m) over CONVERGED_STEP_SD_S and c that of the swing hip\'s sign changes per second (a 10 m walk after CONVERGED_AFTER_S) over CONVERGED_SIGN_CHANGES, each in units of its target and capped at 1; in [-1, 0] once all hold, 0 when both are met.', 0.0),
+    "converged": Objective(_of_base(_converged_score), True, 'The "robust" objective first (while a check fails, its score - 2), then how far the walk is from converged at its own plant step: -(s + c + m) / 3, s the excess of the step period\'s sd (the walk without a window, after the first 10 m) over CONVERGED_STEP_SD_S, c that of the swing hip\'s sign changes per second (a 10 m walk after CONVERGED_AFTER_S) over CONVERGED_SIGN_CHANGES and m that of the half step\'s relative C_mt change over CONVERGED_CMT_CHANGE, each in units of its target and capped at 1; in [-1, 0] once all hold, 0 when all three are met.', 0.0),
     "story": Objective(_of_draws(_story_score), True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
     "hold": Objective(_of_base(_hold_score), True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
     "hold-long": Objective(_of_base(_hold_long_score), True, 'The "robust" objective first, then HOLD_LONG_WINDOWS (t1 across HOLD_BAND, the hip off until the foot lands), each walked HOLD_LONG_M as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change, every walk judged by its long-run C_mt after the first 10 m: the smallest saving (-1 for a fall) plus 0.1 x the mean saving, minus 0.01 d / (1 + d).'),
