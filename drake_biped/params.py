@@ -26,7 +26,7 @@ __all__ = [
     "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
     "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "check_declared",
     "check_given", "check_window_given", "config_of_params", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
-    "CYCLE_INITIAL", "LEARNED_WINDOW_S", "RobotModel",
+    "LEARNED_WINDOW_S", "RobotModel",
 ]
 
 TOTAL_MASS_KG = TABLE_I_TOTAL_MASS_KG
@@ -920,6 +920,3 @@ DEFAULT_CPG, DEFAULT_GAIT = _shipped_default()
 # default of every command that compares a window with none (stability, push-margin, basins, slope,
 # time-step-study) where no --t1/--t2 or --policy is given and the gait carries no window of its own.
 LEARNED_WINDOW_S = (0.3672, 0.8629)
-# A second initiation for the gait "steady" (--params steady), closer to its limit cycle: every acceptance window
-# walks 10 m from it.
-CYCLE_INITIAL = InitialConditions(hip_angle_rad=0.5027, speed_mps=0.5977)

@@ -142,53 +142,6 @@ def test_torque_free_window_saves_energy_without_a_fall():
         assert hips(gated) / gated.distance_m < 0.65 * hips(base) / base.distance_m
 
 
-@pytest.mark.slow
-def test_the_coasting_gait_walks_with_the_hip_off_until_the_foot_lands():
-    """The shipped gait `coasting`'s defining property: its swing hip off from 0.3 s after each touchdown
-    until the next (t2 beyond any step), it walks 10 m and saves (measured: C_mt 0.335 -> 0.276, -18 %);
-    `steady` falls that way (at 1.5 m)."""
-    from drake_biped.resources import load_gait
-
-    coasting = load_gait("coasting")
-    base = run_episode(coasting)
-    coast = run_episode(coasting.replace(window=TorqueFreeWindow(0.3, 5.0)))
-    assert not base.fell and not coast.fell and coast.distance_m >= 10.0
-    steps = np.diff([s.touchdown_time_s for s in coast.steps])
-    assert np.all(steps > 0.3)  # every step ended inside the window: the swing coasted to touchdown
-    assert coast.cost_of_transport < 0.9 * base.cost_of_transport
-    assert run_episode(load_gait("steady").replace(window=TorqueFreeWindow(0.3, 5.0))).fell
-
-
-@pytest.mark.slow
-def test_the_garb_coasting_gait_saves_a_third_coasting_from_0_3_s():
-    """`coasting_garb`, searched from `coasting` for the paper's start policy: coasting from 0.3 s to
-    touchdown saves about a third (measured: C_mt 0.385 -> 0.254, -34 %)."""
-    from drake_biped.resources import load_gait
-
-    gait = load_gait("coasting_garb")
-    base = run_episode(gait)
-    coast = run_episode(gait.replace(window=TorqueFreeWindow(0.3, 5.0)))
-    assert not base.fell and not coast.fell and coast.distance_m >= 10.0
-    assert coast.cost_of_transport < 0.75 * base.cost_of_transport
-
-
-@pytest.mark.slow
-def test_the_wide_coasting_gait_saves_across_the_papers_start_policy():
-    """`coasting_wide`, searched from `coasting_garb` by the expected reward of the paper's start policy:
-    windows from 0.3 to 0.45 s on, ending inside or after the step, walk and save more than 40 % at the gait's
-    own 0.5 ms step (measured on the contact with a continuous limit: C_mt 0.5263 -> 0.2535 at 0.3-0.7 s,
-    0.2732 at 0.45-1.0 s; 0.5-1.0 s, past its powered step's end, saves 20 %)."""
-    from drake_biped.resources import load_gait
-
-    gait = load_gait("coasting_wide")
-    base = run_episode(gait)
-    assert not base.fell and base.distance_m >= 10.0
-    for t1, t2 in ((0.3, 0.7), (0.45, 1.0)):
-        r = run_episode(gait.replace(window=TorqueFreeWindow(t1, t2)))
-        assert not r.fell and r.distance_m >= 10.0, (t1, t2)
-        assert r.cost_of_transport < 0.6 * base.cost_of_transport, (t1, t2)
-
-
 def test_push_changes_the_airborne_robot_momentum_by_exactly_its_impulse():
     """Physics, not bookkeeping: lifted 5 m above the ground (no contact for the 0.6 s simulated), the
     robot's horizontal momentum changes only by external horizontal forces, so across the push it must

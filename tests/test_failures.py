@@ -488,7 +488,7 @@ def _api_argument_cases():
         "build_plant(dict)": (lambda: db.build_plant({"slope_rad": 0.1}), db.ParameterError,
                               "build_plant: ground must be a Ground or None, got dict {'slope_rad': 0.1}"),
         "load_gait(None)": (lambda: db.load_gait(None), db.ParameterError,
-                            "--params None: expected a shipped name (one of ['attracting'"),
+                            "--params None: expected a shipped name (one of ['climbing'"),
         "GarbLearner.from_state({})": (lambda: db.GarbLearner.from_state({}), db.ParameterError,
                                        "GarbLearner.from_state: the state has no 'mean', 'variance'"),
         "from_state(bad rng)": (lambda: db.GarbLearner.from_state({**db.GarbLearner().state(), "rng": 5}),

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from retired_gaits import STEADY
 
 from drake_biped.analysis import floquet as fq
 
@@ -308,7 +309,7 @@ def test_floquet_command_writes_its_record(tmp_path):
     # measured on Drake's default contact (the near-rigid regime on), where this saddle's Jacobian converges
     # over the three perturbations; on the contact with a continuous limit its radius spreads 8-14 over them
     params = tmp_path / "steady_drake_contact.json"
-    params.write_text(json.dumps(load_gait("steady").replace(contact=DRAKE_DEFAULT_CONTACT).to_dict()))
+    params.write_text(json.dumps(load_gait(STEADY).replace(contact=DRAKE_DEFAULT_CONTACT).to_dict()))
     out = tmp_path / "fl"
     assert cli.main(["floquet", "--params", str(params), "--epsilons", "1e-7,1e-6,1e-5", "--workers", "1",
                      "--out", str(out)]) == 0
@@ -338,21 +339,6 @@ def test_floquet_command_writes_its_record(tmp_path):
     # the sampling-phase sentence names the record's own control period
     half = {**record, "config": {**record["config"], "sim": {**record["config"]["sim"], "update_period_s": 5e-4}}}
     assert "the phase of the 0.5 ms control update" in markdown(half)
-
-
-@pytest.mark.slow
-def test_the_attracting_gait_has_an_attracting_orbit():
-    """The shipped gait `attracting` was searched for it on Drake's default contact (the near-rigid regime
-    on): there its period-1 orbit's multipliers, by the searches' one-process Newton and Jacobian
-    (`orbit_radius`), lie inside the unit circle (0.08). On the contact with a continuous limit Newton finds no
-    period-1 orbit (residual 0.011) and its step periods alternate by about 2 ms: docs/RESULTS.md."""
-    from drake_biped.common.floquet_runs import orbit_radius
-    from drake_biped.params import DRAKE_DEFAULT_CONTACT
-    from drake_biped.resources import load_gait
-
-    orbit = orbit_radius(load_gait("attracting").replace(contact=DRAKE_DEFAULT_CONTACT))
-    assert orbit["fixed_point_residual"] < 1e-6
-    assert orbit["spectral_radius"] < 0.2
 
 
 def test_the_decay_check_stays_inside_the_linear_range():

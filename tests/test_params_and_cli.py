@@ -75,7 +75,7 @@ def test_the_params_help_names_every_shipped_gait():
 
     walk = next(a for a in build_parser()._actions if a.dest == "command").choices["walk"]
     text = " ".join(walk.format_help().split())
-    assert "steady" in gait_names()
+    assert "paper" in gait_names()
     assert all(name in text for name in gait_names())
 
 

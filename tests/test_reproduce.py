@@ -250,7 +250,7 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
         return {"checks": {"learn": {"config": config.to_dict()}}}
 
     assert full_run_gait(digest(EpisodeConfig())) is None
-    assert full_run_gait(digest(load_gait("steady"))) == "`steady`"
+    assert full_run_gait(digest(load_gait("paper_servo"))) == "`paper_servo`"
     assert full_run_gait(digest(EpisodeConfig().override({"u_a": 2.0}))) == "another gait"
     assert full_run_gait({"checks": {}}) is None and full_run_gait(None) is None
     # a run on another gait names the default gait's full run, and nothing when the full run is its own

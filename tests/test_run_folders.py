@@ -192,10 +192,10 @@ def test_foreign_records_are_named_not_a_key_error(tmp_path):
         gait_search._check_log(gait_search._read_log(log), settings, "es", log)
     log.write_text(json.dumps({"generation": 0, "parent": {}, "parent_score": 0.1, "objective": "walk",
                                "sigma": 0.1, "mutations": "default", "seed": 0, "policy_draws": 12}) + "\n")
-    coast = gait_search.GaitSearchSettings(objective="coast", sigma=0.3)
-    with pytest.raises(ParameterError, match=r"begun with other settings \(objective 'walk' there, 'coast' here; "
+    other = gait_search.GaitSearchSettings(objective="hold", sigma=0.3)
+    with pytest.raises(ParameterError, match=r"begun with other settings \(objective 'walk' there, 'hold' here; "
                                              r"sigma 0.1 there, 0.3 here\)"):
-        gait_search._check_log(gait_search._read_log(log), coast, "es", log)
+        gait_search._check_log(gait_search._read_log(log), other, "es", log)
     (tmp_path / "time_step_study.json").write_text(json.dumps({"baseline": {}, "windows": []}))
     with pytest.raises(ParameterError, match=r"not a time-step study \(no 'steps'\)"):
         time_step.replot(tmp_path)

@@ -34,7 +34,6 @@ def climbs(name: str, slope_rad: float) -> bool:
 # gait: [(a phrase of its about, the short walk that checks it)]
 CLAIMS = {
     "default": [("a walker of our own", lambda: walks("default"))],
-    "steady": [("it walks from the paper's initiation", lambda: walks("steady"))],
     "paper": [("Table III walks: 100 m at 0.5 ms",
                lambda: load_gait("paper").sim.time_step_s == 0.0005 and walks("paper"))],
     "paper_entrained": [
@@ -48,12 +47,6 @@ CLAIMS = {
     "paper_servo": [("it falls after three steps", lambda: falls_after("paper_servo", 3))],
     "climbing": [("it climbs 0.02 rad without a window", lambda: climbs("climbing", 0.02))],
     "climbing_2deg": [("it climbs 2.0 deg", lambda: climbs("climbing_2deg", math.radians(2.0)))],
-    "coasting": [("at a costly walk without a window", lambda: walks("coasting"))],
-    "coasting_garb": [("beats no window", lambda: walks("coasting_garb"))],
-    "coasting_wide": [("kept with its 0.5 ms step",
-                       lambda: load_gait("coasting_wide").sim.time_step_s == 0.0005 and walks("coasting_wide"))],
-    "holding": [("GARB holds in 5 of 5 trials", lambda: walks("holding"))],
-    "attracting": [("its orbit attracts", lambda: walks("attracting"))],
 }
 
 

@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+from retired_gaits import STEADY
 
 from drake_biped.cli import main
 from drake_biped.experiments.slope import (
@@ -110,7 +111,7 @@ def test_slope_story_on_a_short_setting(tmp_path):
     state, source = start_from_window(0.2, 0.4, 1e-4)  # a tiny variance: samples stay at the period
     with dask_client(workers=2) as client:
         record = run_slope(tmp_path / "climbing", climbing, ground, state, source, 1, 2, 0, client)
-        steady = run_slope(tmp_path / "steady", load_gait("steady").replace(sim=sim), ground, state, source, 1, 1, 0,
+        steady = run_slope(tmp_path / "steady", load_gait(STEADY).replace(sim=sim), ground, state, source, 1, 1, 0,
                            client)
         mtimes = {p: p.stat().st_mtime_ns for p in (tmp_path / "climbing").rglob("*.json")}
         again = run_slope(tmp_path / "climbing", climbing, ground, state, source, 1, 2, 0, client)

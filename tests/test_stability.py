@@ -158,9 +158,9 @@ def test_the_window_compared_is_the_walked_gaits_and_named_or_the_command_asks_f
         assert capsys.readouterr().out.startswith("window 0.1-0.2 s: the cheapest window of this gait's window map")
         assert settings(command).window == LEARNED_WINDOW_S
         assert "learned" in capsys.readouterr().out
-        with pytest.raises(ParameterError, match="--params steady: the gait declares no window.*--t1 and --t2"):
-            settings(command, "--params", "steady")
-        assert settings(command, "--params", "steady", "--t1", "0.2", "--t2", "0.3").window == (0.2, 0.3)
+        with pytest.raises(ParameterError, match="--params paper_servo: the gait declares no window.*--t1 and --t2"):
+            settings(command, "--params", "paper_servo")
+        assert settings(command, "--params", "paper_servo", "--t1", "0.2", "--t2", "0.3").window == (0.2, 0.3)
         assert capsys.readouterr().out == "window 0.2-0.3 s: --t1/--t2\n"
     assert gait_compare_window("default")[0] == LEARNED_WINDOW_S
     # the key is no parameter of the walk: the file still reads as a configuration

@@ -60,7 +60,7 @@ def test_a_named_gait_and_its_windows_are_what_every_step_walks(monkeypatch):
     from drake_biped.experiments import time_step
     from drake_biped.resources import load_gait
 
-    gait = load_gait("coasting_wide")
+    gait = load_gait("paper")
     seen = []
 
     def fake_map(client, fn, items, progress=None):
