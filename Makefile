@@ -51,7 +51,7 @@ docs-figures: setup
 
 # docs/PARAMETERS.md, the controller's parameters slot by slot, from their declarations (tests/test_parameters.py).
 docs-tables: setup
-	$(PY) -c "from drake_biped.controller import parameter_markdown; print(parameter_markdown(), end='')" > docs/PARAMETERS.md
+	$(PY) -c "from drake_biped.control_law import parameter_markdown; print(parameter_markdown(), end='')" > docs/PARAMETERS.md
 
 # Speed and time-step benchmarks (about 8 minutes on 2 cores): Markdown + JSON in out/bench, out/time-step-study.
 bench: setup

@@ -31,7 +31,8 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from drake_biped.common.executor import dask_client, episode_task, map_ordered, peak_rss_mb
-from drake_biped.controller import N_STATE, CpgWalkingController
+from drake_biped.control_kernel import N_STATE
+from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import build_replay_diagram, initial_state
 from drake_biped.episode import run_episode
 from drake_biped.kinematics import center_of_mass

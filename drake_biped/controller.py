@@ -1,48 +1,22 @@
-"""The CPG walking controller as a Drake LeafSystem.
+"""The CPG walking controller as a Drake LeafSystem: `CpgWalkingController`.
 
-One periodic discrete update per control period does all the work: it advances the CPG phase (eq. 2),
-detects touchdown and swaps the legs (resetting the phase), applies the torque-free gate, computes the six
-joint torques (swing-hip PID on the CPG reference, torso balance through the stance hip, bang-bang swing
-knee, constant stance-knee torque, ankles flat to the ground), integrates the motor work, records each
-touchdown's Poincare section state, and ends the episode (an EventStatus the Simulator obeys) on a fall or
-when the centre of mass has walked the distance. The torques are held in a discrete-state group exported
-with DeclareStateOutputPort, so the plant reads them at its own rate without calling back into Python.
+Its one periodic discrete update hands the plant state, its own state and the episode's numbers to the compiled
+update (`control_kernel.control_step`, whose docstring says what the update does and when), then turns the
+update's return code into a touchdown row, the plant motors' new gains (`PlantMotors`) and the
+EventStatus that ends an episode. The episode's numbers are a numeric parameter of its Context (`control_law.LAW`),
+so one built system serves every episode of its structure.
 
 Input port:  "plant_state" (18): MultibodyPlant state q (9), v (9).
 Output ports: "actuation" (6): joint torques (N*m), JOINT_NAMES order, applied by the plant (where the plant
               solves the hip motor, GaitParams.motor_solve "plant", the hips' feedforward: their PD-controlled
               actuators add the motor's torque).
-              "controller_state" (CONTROLLER_STATE): phase, roles, step bookkeeping, work integrals, fall flag.
+              "controller_state" (control_kernel.CONTROLLER_STATE): phase, roles, step bookkeeping, work
+              integrals, fall flag.
               "motor_command" (MOTOR_COMMAND_SIZE): the desired state of the plant's actuated joints, of which
               the hip motors read their rates (connected only where the plant solves the motor).
 Discrete groups: actuation (6), controller state (CONTROLLER_STATE), touchdowns (capacity x TOUCHDOWN), motor
-command (MOTOR_COMMAND_SIZE).
-Both layouts are declared once below; outside the update, read them by name (`CONTROLLER_STATE.view`).
-
-Timing: the plant's output ports are sampled (Drake's default for a discrete plant), so the state the
-update at context time t reads is the plant state at t + h, h the plant time step, and the torques it
-computes act from t + h on: state feedback without delay. The touchdown times and STATE_TIME are the
-times of the states read, which are also the time stamps the state log gives those states.
-
-Events at sub-step accuracy, so that the step map, C_mt and the reward are continuous in the state and in
-the window's bounds (benchmarks/kick_sweep.py measures it): a touchdown is placed at the instant T_n the
-swing foot's clearance crossed the touchdown height, interpolated between two updates; the step clock, the
-CPG phase and the torque-free window all count from T_n; the section angle is interpolated to T_n and the
-section rate extrapolated to T_n from the two updates before it (before the impact, which a 1 ms update
-would otherwise sample at a random depth); and a control period that a window edge cuts applies the
-servo's torque scaled by the part of the period outside the window; a switch of the swing knee's
-bang-bang torque that falls inside a period (its condition crossed along the state extrapolated over the
-period) blends the two torques by the part of the period each holds; and the roles' torques swap at the
-crossing itself: where the clearance, extrapolated over the coming period, crosses the touchdown height
-inside it, that period's torques blend the present roles' and the new roles' by the part of the period
-each holds (GaitParams.swap_timing "predicted"; "update" swaps them at the update that sees the crossing).
-tests/test_hot_path.py and tests/test_gait.py pin this down.
-
-The update's arithmetic is one compiled kernel (`control_step`, numba): Python only hands it the plant state,
-the update's own state vector (written in place) and the episode's numbers, a numeric parameter of the
-context packed once per episode (`LAW`, `law_vector`, `set_episode`), and turns its return code into the touchdown row and the EventStatus. An episode that records
-nothing calls the kernel itself between the plant's steps, on this system's state in the same context
-(episode._step_directly), with the same numbers.
+command (MOTOR_COMMAND_SIZE). The torques are held in a discrete-state group exported with
+DeclareStateOutputPort, so the plant reads them at its own rate without calling back into Python.
 """
 
 from __future__ import annotations
@@ -52,250 +26,44 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
-from drake_biped.cpg import advance_phase_k, output_k, phase_rate_k, swing_reference, torque_free_fraction
-from drake_biped.gait import (
-    ankle_torque_k,
-    clip,
-    hip_servo_torque_k,
-    is_touchdown_k,
-    placement_feedback_k,
-    swing_knee_torque_over_k,
-    torso_torque_k,
+from drake_biped.control_kernel import (
+    COM_X,
+    CONTACT_RIGHT,
+    CONTROLLER_STATE,
+    DIVERGED_REVERSALS,
+    DONE_BIT,
+    FALL,
+    FALL_REASONS,
+    FELL,
+    GAMMA,
+    LIFTOFF_ANGLE,
+    MOTOR_BOUND,
+    MOTOR_COMMAND_SIZE,
+    MOTOR_GAIN,
+    MOTOR_MODEL_RATE,
+    MOTORS,
+    N_STATE,
+    PREV_CLEARANCE,
+    PREV_PITCH,
+    PREV_RATES,
+    Q_PREV,
+    RECENT_REVERSALS,
+    STANCE_RIGHT,
+    STEP_COUNT,
+    TARGET_X,
+    TAU,
+    TOUCHED,
+    control_step,
+    touchdown_capacity,
 )
-from drake_biped.jit import njit
-from drake_biped.kinematics import (
-    B_ANKLE_EFFORT,
-    B_HIP_EFFORT,
-    B_KNEE_EFFORT,
-    BODY,
-    TABLE_I_BODY,
-    center_of_mass_k,
-    leg_points_k,
+from drake_biped.control_kernel import (
+    TOUCHDOWN_ROW as _TD,
 )
-from drake_biped.layout import Field, VectorLayout
-from drake_biped.model import JOINTS_OF_A_LEG, LEGS, joint_index
-from drake_biped.params import (
-    CpgParams,
-    EpisodeConfig,
-    GaitParams,
-    Ground,
-    SimulationParams,
-    TorqueFreeWindow,
-    parameter_info,
-)
-
-# The "controller_state" discrete group, declared once; the update below uses the offsets generated here.
-CONTROLLER_STATE = VectorLayout("controller_state", (
-    Field("cpg_phase", 1, "CPG phase gamma (rad)"),
-    Field("stance_right", 1, "1.0 when the right leg is the stance leg (its hip balances the torso)"),
-    Field("contact_right", 1, "1.0 when the right foot landed last (the stance leg under phase_reading 'reset')"),
-    Field("step_start_s", 1, "T_n, the last touchdown: when the swing foot's clearance crossed the touchdown "
-                             "height, interpolated within the control period (plant-state time, s)"),
-    Field("liftoff_angle_rad", 1, "swing thigh world angle at T_n (rad)"),
-    Field("step_count", 1, "touchdowns so far"),
-    Field("hip_integral", 1, "swing-hip PID integrator (rad*s)"),
-    Field("torque_free", 1, "the part of the control period the swing hip is torque-free (1.0: all of it)"),
-    Field("fall_code", 1, "why the episode fell, a key of FALL_REASONS (0: it did not)"),
-    Field("com_x_m", 1, "whole-body centre of mass x at the last update (m)"),
-    Field("target_x_m", 1, "the episode ends when com_x_m reaches this (m)"),
-    Field("done", 1, "1.0 once the distance is walked"),
-    Field("state_time_s", 1, "time of the plant state read by the last update (s)"),
-    Field("previous_joint_angles_rad", 6, "joint angles at the previous update, JOINT_NAMES order (rad)"),
-    Field("torques_nm", 6, "torques held since the previous update, a copy of the actuation group (N*m)"),
-    Field("positive_work_j", 6, "per-joint integrals of max(tau * omega, 0) dt (J)"),
-    Field("signed_work_j", 6, "per-joint integrals of tau * omega dt (J)"),
-    Field("previous_clearance_m", 1, "the swing foot's clearance at the previous update (m)"),
-    Field("previous_pitch_rad", 1, "torso pitch at the previous update (rad)"),
-    Field("previous_section_rates_radps", 2, "swing minus stance hip rate at the previous two updates, latest "
-                                             "first; NaN until read in this step (rad/s)"),
-    Field("swing_travel_rad", 1, "integral of zeta since T_n: the swing thigh's travel under the integrated "
-                                 "reading (rad)"),
-    Field("torque_reversals", 1, "updates at which a joint's torque jumped by more than REVERSAL_FACTOR times its "
-                                 "motor's limit from the previous control period (a diverging control loop)"),
-    Field("recent_reversals_s", 5, "the times of the last DIVERGED_REVERSALS reversals, latest first (-inf: none)"),
-    Field("motor_model_rate_radps", 1, "the hip motor's coordinate rate its model expects at this update, from the "
-                                       "last (NaN: none since the roles last swapped)"),
-    Field("motor_disturbance_radps", 1, "what that model missed at the last update: the rate measured minus it"),
-    Field("hip_motor_gain_nms", 2, "the plant's hip motors (motor_solve 'plant'), left and right: each hip "
-                                   "actuator's velocity gain over the coming period (MOTOR_OFF_GAIN: a plain torque)"),
-    Field("hip_motor_target_radps", 2, "the hip joint rate each motor drives to over the coming period (rad/s)"),
-    Field("hip_motor_bound_nm", 2, "each hip actuator's torque bound over the coming period, its motor's "
-                                   "feedforward included (0: no torque)"),
-    Field("positive_work_by_role_j", 6, "integrals of max(tau * omega, 0) dt by the joint's role over each period, "
-                                        "model.ROLES order (J)"),
-    Field("negative_work_by_role_j", 6, "integrals of min(tau * omega, 0) dt by role, model.ROLES order (J)"),
-))
-N_STATE = CONTROLLER_STATE.size
-_o = CONTROLLER_STATE.offset
-GAMMA, STANCE_RIGHT, STEP_START, LIFTOFF_ANGLE = _o("cpg_phase"), _o("stance_right"), _o("step_start_s"), \
-    _o("liftoff_angle_rad")
-CONTACT_RIGHT = _o("contact_right")
-STEP_COUNT, INTEGRAL, GATE, FALL = _o("step_count"), _o("hip_integral"), _o("torque_free"), _o("fall_code")
-COM_X, TARGET_X, DONE, STATE_TIME = _o("com_x_m"), _o("target_x_m"), _o("done"), _o("state_time_s")
-Q_PREV, TAU = _o("previous_joint_angles_rad"), _o("torques_nm")
-POSITIVE_WORK, SIGNED_WORK, PREV_CLEARANCE = _o("positive_work_j"), _o("signed_work_j"), _o("previous_clearance_m")
-PREV_PITCH, PREV_RATES, TRAVEL = _o("previous_pitch_rad"), _o("previous_section_rates_radps"), _o("swing_travel_rad")
-REVERSALS, RECENT_REVERSALS = _o("torque_reversals"), _o("recent_reversals_s")
-MOTOR_MODEL_RATE, MOTOR_DISTURBANCE = _o("motor_model_rate_radps"), _o("motor_disturbance_radps")
-MOTOR_GAIN, MOTOR_TARGET, MOTOR_BOUND = _o("hip_motor_gain_nms"), _o("hip_motor_target_radps"), _o("hip_motor_bound_nm")
-ROLE_POSITIVE, ROLE_NEGATIVE = _o("positive_work_by_role_j"), _o("negative_work_by_role_j")
-del _o
-
-# One row of the "touchdowns" group per touchdown, written once, at the update that detects it.
-TOUCHDOWN = VectorLayout("touchdown", (
-    Field("time_s", 1, "when the swing foot's clearance crossed the touchdown height (s)"),
-    Field("hip_angle_rad", 1, "section state: new stance thigh minus new swing thigh (rad)"),
-    Field("hip_rate_radps", 1, "its rate (rad/s)"),
-    Field("stance_right", 1, "1.0 when the new stance leg is the right one"),
-    Field("com_x_m", 1, "centre of mass x (m)"),
-    Field("positive_work_j", 1, "the motors' positive work since the start, all joints (J)"),
-))
-TOUCHDOWN_FIELDS = TOUCHDOWN.names
-_TD = TOUCHDOWN.size
-MAX_TOUCHDOWNS = 4096
-
-# Indices of the legs' joints: in the plant's positions and velocities (the planar base's 3 come first) and
-# in the actuation and torque vectors; a leg's knee and ankle follow its hip.
-Q_HIP = {leg: 3 + joint_index(leg, "hip") for leg in LEGS}
-Q_HIP_LEFT, Q_HIP_RIGHT = Q_HIP["left"], Q_HIP["right"]
-KNEE, ANKLE = JOINTS_OF_A_LEG.index("knee"), JOINTS_OF_A_LEG.index("ankle")
-
-FALL_REASONS = {
-    0: "",
-    1: "hip below the fall height",
-    2: "torso tilted beyond the fall angle",
-    3: "knee touched the ground",
-    4: "non-finite state",
-    5: "the control loop diverged",
-}
-# A diverging control loop (a control period too long for the servos' gains: the torques chatter between their
-# limits) is told from a walk by the rate of torque reversals: a joint's torque jumping by more than
-# REVERSAL_FACTOR times its motor's limit from one period to the next. A chattering loop reverses at nearly every
-# period; an impact or a push makes one reversal, rarely two, and a long walk may gather a few over hundreds of
-# steps. So the episode ends as diverged when DIVERGED_REVERSALS reversals fall within DIVERGENCE_SPAN_PERIODS
-# control periods (20 ms at 1 ms): a rate, not a total.
-REVERSAL_FACTOR = 1.5
-DIVERGED_REVERSALS = 5
-DIVERGENCE_SPAN_PERIODS = 20
-DIVERGED_CODE = 5
-# How much of what the hip motor's model missed at the last update it adds at the next (a low pass: an impact
-# that the model misses for one update does not set the motor ringing).
-MOTOR_DISTURBANCE_GAIN = 0.5
-# The plant's hip motor (GaitParams.motor_solve "plant") is a PD-controlled actuator on each hip, proportional gain
-# 0. Drake fixes which actuators are PD-controlled when the plant first steps, so the hip that is not driven keeps
-# its actuator with this negligible velocity gain (its torque is the feedforward to within 1e-12 N*m per rad/s of
-# its rate's change over a step; the update counts that part too).
-MOTOR_OFF_GAIN = 1e-12
-# The motor's command: the desired state of the plant's actuated joints (q_d, then v_d, in actuator order); only
-# the hips' desired rates are read (the motors have no proportional gain, the other joints no PD).
-MOTOR_COMMAND_SIZE = 12
-
-
-def plant_motor(config: EpisodeConfig) -> bool:
-    """Whether the plant solves the hip motor (GaitParams.hip_drive "motor", motor_solve "plant"): its hips are
-    then PD-controlled actuators, driven through the controller's "motor_command" output."""
-    return config.gait.hip_drive == "motor" and config.gait.motor_solve == "plant"
-
-
-def touchdown_capacity(config: EpisodeConfig) -> int:
-    """Rows reserved for touchdowns: enough for the whole episode at the shortest accepted step."""
-    shortest = max(config.gait.touchdown_min_step_s, config.sim.update_period_s)
-    return min(MAX_TOUCHDOWNS, int(math.ceil(config.sim.max_time_s / shortest)) + 1)
-
-
-
-# The episode's numbers as the compiled update takes them: one vector, packed by law_vector() into the context's
-# numeric parameter when an episode is set (`set_episode`), read in the kernel through the constants below.
-# What the Context parameter copies from the episode's configuration, one slot each, in order: (section,
-# field, the slot's name). Each field's doc, unit and bounds are its declaration in params (`param`).
-LAW_COPIED = (
-    *(("cpg", n, n) for n in ("alpha", "u_a", "u_eta", "u_r", "kappa")),
-    *(("gait", n, n) for n in ("swing_offset_rad", "hip_kp", "hip_kd", "hip_ki", "placement_gain",
-                               "placement_velocity_gain", "torso_kp", "torso_kd", "torso_pitch_rad")),
-    # the swing knee's law, in swing_knee_torque_k's order (gait.knee_law)
-    *(("gait", n, n) for n in ("knee_extend_phase", "knee_extend_thigh_rad", "knee_flex_max_rad",
-                               "knee_flex_until_phase", "knee_flex_torque", "knee_extend_torque",
-                               "knee_hold_torque")),
-    *(("gait", n, n) for n in ("stance_knee_torque", "ankle_kp", "ankle_kd")),
-    # the touchdown's conditions, in is_touchdown_k's order (gait.touchdown_rule)
-    *(("gait", n, n) for n in ("touchdown_min_step_s", "touchdown_height_m", "touchdown_min_advance_m",
-                               "touchdown_min_phase")),
-    ("window", "start_s", "window_start_s"), ("window", "end_s", "window_end_s"),
-    ("window", "first_step", "window_first_step"),
-    ("ground", "slope_rad", "ground_slope_rad"), ("ground", "level_length_m", "ground_level_length_m"),
-    ("sim", "fall_hip_height_m", "fall_hip_height_m"), ("sim", "fall_pitch_rad", "fall_pitch_rad"),
-    ("gait", "motor_limit_nm", "motor_limit_nm"), ("gait", "motor_time_constant_s", "motor_time_constant_s"),
-    ("gait", "motor_gain_nms", "motor_gain_nms"),
-)
-_SECTION_TYPES = {"cpg": CpgParams, "gait": GaitParams, "window": TorqueFreeWindow, "ground": Ground,
-                  "sim": SimulationParams}
-
-
-def _copied(section: str, name: str, slot: str | None = None) -> Field:
-    """The LAW slot that copies params section `section`'s field `name`, declared there."""
-    info = parameter_info(_SECTION_TYPES[section], name)
-    doc = f"{_SECTION_TYPES[section].__name__}.{name}: {info['doc']}"
-    if section == "ground" and name == "level_length_m":
-        doc += " (NaN for None)"
-    if section == "gait" and name == "touchdown_min_phase":
-        doc += " (-inf under phase_reading 'entrained': the phase does not follow the steps)"
-    return Field(slot or name, 1, doc, info["unit"], info["bounds"])
-
-
-_DERIVED = {  # the slots computed from the configuration, before and among the copied ones
-    "update_period_s": Field("update_period_s", 1, "the controller's update period: the plant step under the "
-                             "paper's clock, else the fixed-rate loop's (SimulationParams.update_period_s)", "s"),
-    "state_lag_s": Field("state_lag_s", 1, "the plant step: the state read at update time t is the state at "
-                         "t + lag (SimulationParams.time_step_s)", "s"),
-    "swing_amplitude_rad": Field("swing_amplitude_rad", 1, "alpha u_a / u_r (CpgParams.swing_amplitude_rad)", "rad"),
-    "integrated": Field("integrated", 1, "1 for GaitParams.swing_reading 'integrated', 0 for 'anchored'", "1"),
-    "predicted_swap": Field("predicted_swap", 1, "1 for GaitParams.swap_timing 'predicted', 0 for 'update'", "1"),
-    "entrained": Field("entrained", 1, "1 for GaitParams.phase_reading 'entrained', 0 for 'reset'", "1"),
-    "ground_tan_slope": Field("ground_tan_slope", 1, "tan(Ground.slope_rad)", "1"),
-    "hip_motor": Field("hip_motor", 1, "1 for GaitParams.hip_drive 'motor' (zeta the hip joint's velocity, "
-                       "reached each update), 0 for 'servo'", "1"),
-    "inter_leg": Field("inter_leg", 1, "1 for GaitParams.hip_joint 'inter_leg', 0 for 'swing'", "1"),
-    "motor_plant": Field("motor_plant", 1, "1 for the hip motor solved in the plant's step (GaitParams.hip_drive "
-                         "'motor', motor_solve 'plant'), else 0", "1"),
-}
-_COPIED = {slot: _copied(section, name, slot) for section, name, slot in LAW_COPIED}
-# The controller's numbers for one episode, a numeric parameter of its Context: every slot with its doc, unit
-# and bounds (docs/PARAMETERS.md is generated from it: `parameter_markdown`).
-LAW = VectorLayout("law", tuple(({**_DERIVED, **_COPIED})[name] for name in (
-    "update_period_s", "state_lag_s", "alpha", "u_a", "u_eta", "u_r", "kappa", "swing_amplitude_rad",
-    "integrated", "predicted_swap", "entrained", "swing_offset_rad", "hip_kp", "hip_kd", "hip_ki",
-    "placement_gain", "placement_velocity_gain", "torso_kp", "torso_kd", "torso_pitch_rad",
-    "knee_extend_phase", "knee_extend_thigh_rad", "knee_flex_max_rad", "knee_flex_until_phase", "knee_flex_torque",
-    "knee_extend_torque", "knee_hold_torque", "stance_knee_torque", "ankle_kp", "ankle_kd",
-    "touchdown_min_step_s", "touchdown_height_m", "touchdown_min_advance_m", "touchdown_min_phase",
-    "window_start_s", "window_end_s", "window_first_step", "ground_slope_rad", "ground_tan_slope",
-    "ground_level_length_m", "fall_hip_height_m", "fall_pitch_rad", "hip_motor", "inter_leg", "motor_limit_nm",
-    "motor_time_constant_s", "motor_plant", "motor_gain_nms")))
-_o = LAW.offset
-L_DT, L_LAG, L_ALPHA, L_UA, L_UETA, L_UR, L_KAPPA = (_o(n) for n in ("update_period_s", "state_lag_s", "alpha", "u_a",
-                                                                    "u_eta", "u_r", "kappa"))
-L_AMPLITUDE, L_INTEGRATED, L_PREDICTED, L_OFFSET = (_o(n) for n in ("swing_amplitude_rad", "integrated",
-                                                                   "predicted_swap", "swing_offset_rad"))
-L_ENTRAINED = _o("entrained")
-L_HIP_KP, L_HIP_KD, L_HIP_KI, L_PLACE, L_PLACE_V = (_o(n) for n in ("hip_kp", "hip_kd", "hip_ki", "placement_gain",
-                                                                   "placement_velocity_gain"))
-L_TORSO_KP, L_TORSO_KD, L_TORSO_PITCH, L_KNEE, L_STANCE_KNEE = (_o(n) for n in (
-    "torso_kp", "torso_kd", "torso_pitch_rad", "knee_extend_phase", "stance_knee_torque"))
-L_ANKLE_KP, L_ANKLE_KD, L_TOUCHDOWN = _o("ankle_kp"), _o("ankle_kd"), _o("touchdown_min_step_s")
-L_T1, L_T2, L_FIRST_STEP = _o("window_start_s"), _o("window_end_s"), _o("window_first_step")
-L_SLOPE, L_TAN, L_LEVEL = _o("ground_slope_rad"), _o("ground_tan_slope"), _o("ground_level_length_m")
-L_FALL_HEIGHT, L_FALL_PITCH = _o("fall_hip_height_m"), _o("fall_pitch_rad")
-L_MOTOR, L_INTER_LEG, L_MOTOR_LIMIT = _o("hip_motor"), _o("inter_leg"), _o("motor_limit_nm")
-L_MOTOR_TAU, L_MOTOR_PLANT, L_MOTOR_GAIN = _o("motor_time_constant_s"), _o("motor_plant"), _o("motor_gain_nms")
-del _o
-
-# What the hip motor (GaitParams.hip_drive "motor") reads of the plant's dynamics at each update, computed by
-# `CpgWalkingController.motor_dynamics` from the state the update reads: the mass matrix M (9 x 9), the rows
-# of the constraints that hold (the stance foot's contact: heel x, heel z, toe z; each knee at its stop), up to
-# DYN_ROWS of 9, their number, and f = gravity - bias (9), row-major.
-DYN_ROWS = 5
-DYN_M, DYN_J, DYN_N, DYN_F = 0, 81, 81 + 9 * DYN_ROWS, 82 + 9 * DYN_ROWS
-DYN_SIZE = DYN_F + 9
+from drake_biped.control_law import L_MOTOR, L_MOTOR_PLANT, LAW, LAW_COPIED
+from drake_biped.hip_motor import DYN_SIZE, MOTOR_NO_TORQUE, MOTOR_OFF_GAIN, PlantDynamics
+from drake_biped.kinematics import B_HIP_EFFORT, BODY, TABLE_I_BODY
+from drake_biped.model import LEGS
+from drake_biped.params import EpisodeConfig
 
 
 def law_vector(config: EpisodeConfig) -> np.ndarray:
@@ -320,583 +88,11 @@ def law_vector(config: EpisodeConfig) -> np.ndarray:
     put("ground_tan_slope", math.tan(ground.slope_rad))
     put("hip_motor", 1.0 if g.hip_drive == "motor" else 0.0)
     put("inter_leg", 1.0 if g.hip_joint == "inter_leg" else 0.0)
-    put("motor_plant", 1.0 if plant_motor(config) else 0.0)
+    put("motor_plant", 1.0 if config.gait.plant_motor else 0.0)
     return v
 
 
-def _section_markdown(cls: type) -> str:
-    """One section of EpisodeConfig as a Markdown table, from its fields' declarations (`param`)."""
-    from dataclasses import fields
-
-    def bounds(b) -> str:
-        if b is None or b == (None, None):
-            return ""
-        return f"[{'-inf' if b[0] is None else f'{b[0]:g}'}, {'inf' if b[1] is None else f'{b[1]:g}'}]"
-
-    rows = ["| field | default | unit | bounds | meaning |", "|---|---|---|---|---|"]
-    for f in fields(cls):
-        if "doc" in f.metadata:
-            default = f.default if not isinstance(f.default, float) else f"{f.default:g}"
-            rows.append(f"| `{f.name}` | {default!s} | {f.metadata['unit'] or '-'} | {bounds(f.metadata['bounds'])} "
-                        f"| {f.metadata['doc'].replace('|', '/')} |")
-    return "\n".join(rows) + "\n"
-
-
-def parameter_markdown() -> str:
-    """docs/PARAMETERS.md: the controller's Context parameter (LAW), slot by slot, and every section of an
-    episode's configuration, field by field, from their declarations."""
-    from drake_biped.params import ContactParams, EpisodeConfig, InitialConditions, Push
-
-    sections = {"cpg": CpgParams, "gait": GaitParams, "initial": InitialConditions, "window": TorqueFreeWindow,
-                "ground": Ground, "push": Push, "sim": SimulationParams, "contact": ContactParams,
-                "(top level)": EpisodeConfig}
-    configuration = "".join(f"\n### `{name}`: {cls.__name__}\n\n" + _section_markdown(cls)
-                            for name, cls in sections.items())
-    return ("# Parameters\n\n"
-            "Generated from the code (`make docs-tables`; tests/test_parameters.py checks it is current).\n\n"
-            "## The controller's Context parameter\n\n"
-            "The controller's numbers for one episode are one numeric parameter of its Drake Context, `LAW` in "
-            "drake_biped/controller.py: the slots that copy a field of the episode's configuration take its "
-            "declaration in drake_biped/params.py (`param`: default, unit, bounds, meaning); the others are "
-            "computed from it. Unit `1`: dimensionless (a gain ratio, a flag 1 or 0, a count of steps).\n\n"
-            + LAW.markdown()
-            + "\n## The episode's configuration\n\n"
-            "Every field of `EpisodeConfig`'s sections, as a params file or `config.override({\"section.field\": "
-            "value})` names it, with the dataclass's default (`CpgParams()`; `EpisodeConfig()` takes the default gait's "
-            "CPG and gait sections, drake_biped/gaits/default.json, and a shipped gait file its own), unit, bounds "
-            "(the dataclass refuses a value outside them) and meaning. Unit `-`: a choice among named readings.\n"
-            + configuration)
-
-
-# The kernel's return code: bits for what the Python side must do after it.
-TOUCHED, FELL, DONE_BIT = 1, 2, 4
-MOTORS = 8  # the plant's hip motors take other gains or bounds from this update on (CpgWalkingController.apply_motors)
-
-# Leg points tuple (kinematics.leg_points_k): the slots the update reads.
-_KNEE_X, _KNEE_Z, _ANKLE_X, _HEEL_X, _HEEL_Z, _TOE_X, _TOE_Z, _THIGH, _FOOT, _HIP_X, _HIP_Z = 0, 1, 2, 4, 5, 6, 7, 8, 10, \
-    11, 12
-
-
-@njit
-def legs_k(right_stance: bool, left: tuple, right: tuple) -> tuple:
-    """(stance hip's index, swing hip's index in q and v, stance leg's points, swing leg's points) when the
-    right leg is the stance leg or not."""
-    if right_stance:
-        return Q_HIP_RIGHT, Q_HIP_LEFT, right, left
-    return Q_HIP_LEFT, Q_HIP_RIGHT, left, right
-
-
-@njit
-def ground_height_k(law, x: float) -> float:
-    """params.Ground.height() from the LAW vector."""
-    level = law[L_LEVEL]
-    if level != level:  # NaN: the slope everywhere
-        return x * law[L_TAN]
-    return max(0.0, (x - level) * law[L_TAN])
-
-
-@njit
-def ground_slope_k(law, x: float) -> float:
-    """params.Ground.slope_at() from the LAW vector."""
-    level = law[L_LEVEL]
-    if level != level or x >= level:
-        return law[L_SLOPE]
-    return 0.0
-
-
-@njit
-def predicted_touchdown_k(law, s, now: float, clearance: float, c_prev: float, advance: float,
-                          stance_ankle_rate: float) -> float:
-    """The part of the coming control period before the swing foot's clearance, extrapolated linearly
-    from this update and the previous one, crosses the touchdown height, when the touchdown would be
-    confirmed at the period's end; -1 when no touchdown is predicted in it."""
-    rule = (law[L_TOUCHDOWN], law[L_TOUCHDOWN + 1], law[L_TOUCHDOWN + 2], law[L_TOUCHDOWN + 3])
-    thr = rule[1]
-    if not (math.isfinite(c_prev) and clearance > thr):
-        return -1.0
-    c_end = 2.0 * clearance - c_prev
-    if c_end >= thr:
-        return -1.0
-    dt = law[L_DT]
-    gamma_end = advance_phase_k(law[L_UR], law[L_KAPPA], s[GAMMA], stance_ankle_rate, dt)
-    if not is_touchdown_k(rule, now + dt - s[STEP_START], c_end, advance, gamma_end):
-        return -1.0
-    return (clearance - thr) / (clearance - c_end)
-
-
-@njit
-def cholesky_k(a, n: int):
-    """The lower Cholesky factor L (a = L L^T) of the symmetric positive definite n x n matrix `a`, by the
-    Cholesky-Banachiewicz loops in a fixed order: the same rounding on every x86-64 CPU, where a BLAS or LAPACK
-    call picks its kernel (and so its order of operations) per CPU."""
-    low = np.zeros((n, n))
-    for i in range(n):
-        for j in range(i + 1):
-            total = a[i, j]
-            for k in range(j):
-                total -= low[i, k] * low[j, k]
-            if i == j:
-                low[i, i] = math.sqrt(total) if total > 0.0 else math.nan
-            else:
-                low[i, j] = total / low[j, j]
-    return low
-
-
-@njit
-def cholesky_solve_k(low, b, n: int) -> None:
-    """Solve (L L^T) x = b in place, for the columns of b (n x m), by forward and back substitution in a fixed
-    order."""
-    for c in range(b.shape[1]):
-        for i in range(n):
-            total = b[i, c]
-            for k in range(i):
-                total -= low[i, k] * b[k, c]
-            b[i, c] = total / low[i, i]
-        for i in range(n - 1, -1, -1):
-            total = b[i, c]
-            for k in range(i + 1, n):
-                total -= low[k, i] * b[k, c]
-            b[i, c] = total / low[i, i]
-
-
-@njit
-def constrained_inverse_k(dyn) -> tuple:
-    """(P, b) from the plant's dynamics `dyn` (DYN_*): P = M^-1 - M^-1 Jc^T (Jc M^-1 Jc^T)^-1 Jc M^-1, the
-    generalized accelerations per unit generalized force with the constraints that hold (the stance foot held
-    by its contact, a knee at its stop), and b = P f, the accelerations of gravity and the velocity terms
-    alone. Both Gram matrices (M, Jc M^-1 Jc^T) are symmetric positive definite and solved by Cholesky loops of
-    our own in a fixed order, with no BLAS call, so that a walk gives the same digits on every x86-64 CPU."""
-    n = 9
-    m = np.empty((n, n))
-    for i in range(n):
-        for j in range(n):
-            m[i, j] = dyn[DYN_M + n * i + j]
-    rows = int(dyn[DYN_N])
-    low = cholesky_k(m, n)
-    mi = np.zeros((n, n))  # M^-1, column by column
-    for i in range(n):
-        mi[i, i] = 1.0
-    cholesky_solve_k(low, mi, n)
-    mi_jt = np.empty((n, rows))  # M^-1 Jc^T
-    for c in range(rows):
-        for i in range(n):
-            mi_jt[i, c] = dyn[DYN_J + n * c + i]
-    cholesky_solve_k(low, mi_jt, n)
-    gram = np.empty((rows, rows))  # Jc M^-1 Jc^T
-    for r in range(rows):
-        for c in range(rows):
-            total = 0.0
-            for k in range(n):
-                total += dyn[DYN_J + n * r + k] * mi_jt[k, c]
-            gram[r, c] = total
-    for r in range(rows):  # symmetric to the last bit, as its factor assumes
-        for c in range(r):
-            gram[r, c] = gram[c, r] = 0.5 * (gram[r, c] + gram[c, r])
-    gram_low = cholesky_k(gram, rows)
-    k_t = np.empty((rows, n))  # (Jc M^-1 Jc^T)^-1 Jc M^-1, i.e. the transpose of M^-1 Jc^T (Jc M^-1 Jc^T)^-1
-    for r in range(rows):
-        for i in range(n):
-            k_t[r, i] = mi_jt[i, r]
-    cholesky_solve_k(gram_low, k_t, rows)
-    p = np.empty((n, n))
-    for i in range(n):
-        for j in range(n):
-            total = mi[i, j]
-            for r in range(rows):
-                total -= mi_jt[i, r] * k_t[r, j]
-            p[i, j] = total
-    b = np.empty(n)
-    for i in range(n):
-        total = 0.0
-        for j in range(n):
-            total += p[i, j] * dyn[DYN_F + j]
-        b[i] = total
-    return p, b
-
-
-@njit
-def motor_coordinate_k(law, v, sw_i: int, st_i: int) -> float:
-    """The rate the hip motor drives: the swing hip joint's, or the inter-leg angle's (swing minus stance)."""
-    return v[sw_i] - v[st_i] if law[L_INTER_LEG] != 0.0 else v[sw_i]
-
-
-@njit
-def realized_hip_torques_k(s, v, tau) -> None:
-    """The plant's hip motors (motor_solve "plant"): the torque each hip's actuator applied over the period
-    that just ended, into s[TAU + hip], as the plant's step computed it (Drake's PD-controlled actuator at the
-    step's end rate: -gain (rate - target) + feedforward, clipped to the bound); `tau`: the feedforward held."""
-    for leg in range(2):
-        j = 3 * leg  # the hip's torque index (JOINT_NAMES: a leg's hip first)
-        bound = s[MOTOR_BOUND + leg]
-        u = -s[MOTOR_GAIN + leg] * (v[Q_HIP_LEFT + j] - s[MOTOR_TARGET + leg]) + tau[j]
-        s[TAU + j] = 0.0 if bound <= 0.0 else clip(u, bound)
-
-
-@njit
-def motor_model_k(law, dyn, v, dt: float, sw_i: int, st_i: int, others, torso: float) -> tuple:
-    """(rate, gain, offset): the model's rate of the motor's coordinate (`motor_coordinate_k`) at the end of
-    the update is rate + gain * (swing hip torque - offset), given the other joints' torques `others` (9
-    generalized forces, the hips' zero) and the torso's torque law `torso` (the hips' summed torque): the
-    stance hip gives torso - swing hip torque (hip_joint "swing"); under "inter_leg" the hips' common mode holds
-    the torso and their difference mode (swing - offset, offset = torso / 2) drives the legs apart."""
-    p, b = constrained_inverse_k(dyn)
-    u = others.copy()
-    if law[L_INTER_LEG] != 0.0:
-        u[sw_i] += 0.5 * torso
-        u[st_i] += 0.5 * torso
-        rate = v[sw_i] - v[st_i] + dt * (b[sw_i] - b[st_i])
-        for j in range(9):
-            rate += dt * (p[sw_i, j] - p[st_i, j]) * u[j]
-        return rate, dt * (p[sw_i, sw_i] - p[sw_i, st_i] - p[st_i, sw_i] + p[st_i, st_i]), 0.5 * torso
-    u[st_i] += torso
-    rate = v[sw_i] + dt * b[sw_i]
-    for j in range(9):
-        rate += dt * p[sw_i, j] * u[j]
-    return rate, dt * (p[sw_i, sw_i] - p[sw_i, st_i]), 0.0
-
-
-@njit
-def period_torques_k(law, body, s, q, v, now: float, stance_right: bool, stance: tuple, swing: tuple,
-                     dyn) -> None:
-    """The six torques over the period [now, now + dt) for the given roles, into s[TAU:], advancing
-    the CPG phase, the swing travel, the hip integrator and the gate in s."""
-    dt = law[L_DT]
-    if stance_right:
-        st_i, sw_i = Q_HIP_RIGHT, Q_HIP_LEFT
-    else:
-        st_i, sw_i = Q_HIP_LEFT, Q_HIP_RIGHT
-    pitch, pitch_rate = q[2], v[2]
-    hip_ahead = stance[_HIP_X] - stance[_ANKLE_X]  # the hip joint ahead of the stance ankle
-    # This update's torques act over [now, now + dt): `elapsed` after T_n at its start.
-    elapsed = now - s[STEP_START]
-
-    # CPG (eq. 2-3) and the swing reference.
-    gamma = advance_phase_k(law[L_UR], law[L_KAPPA], s[GAMMA], v[st_i + ANKLE], dt)
-    zeta = output_k(law[L_ALPHA], law[L_UA], law[L_UETA], gamma)
-    s[GAMMA] = gamma
-    s[TRAVEL] += dt * zeta
-    if law[L_INTEGRATED] != 0.0:
-        # Table III's zeta drives the swing as printed: the reference angle is its integral from the
-        # lift-off angle; placement feedback only adds an offset, blended in over the half-cycle.
-        offset = law[L_OFFSET] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], hip_ahead, v[0])
-        reference = s[LIFTOFF_ANGLE] + s[TRAVEL] + offset * 0.5 * (1.0 - math.cos(gamma))
-    else:
-        target = law[L_AMPLITUDE] + placement_feedback_k(law[L_PLACE], law[L_PLACE_V], hip_ahead, v[0])
-        reference = swing_reference(gamma, s[LIFTOFF_ANGLE], target)
-    swing_rate = pitch_rate + v[sw_i]
-    angle_error = reference - swing[_THIGH]
-
-    # Torque-free gate: the servo's torque scaled by the part of the period outside the window (exactly
-    # zero for a period inside it), the integrator advanced by that part only.
-    free = 0.0
-    if s[STEP_COUNT] >= law[L_FIRST_STEP]:
-        free = torque_free_fraction(elapsed, dt, law[L_T1], law[L_T2])
-    s[GATE] = free
-    a_sw, a_st = TAU + sw_i - 3, TAU + st_i - 3  # the legs' hip torques (the knee and ankle follow)
-    # the swing knee's switches placed inside the period, along the state extrapolated over it
-    knee = (law[L_KNEE], law[L_KNEE + 1], law[L_KNEE + 2], law[L_KNEE + 3], law[L_KNEE + 4], law[L_KNEE + 5],
-            law[L_KNEE + 6])
-    knee_start = (gamma, q[sw_i + KNEE], swing[_THIGH])
-    knee_end = (advance_phase_k(law[L_UR], law[L_KAPPA], gamma, v[st_i + ANKLE], dt), q[sw_i + KNEE] + dt * v[sw_i + KNEE],
-                swing[_THIGH] + dt * swing_rate)
-    knee_limit = body[B_KNEE_EFFORT]
-    s[a_sw + KNEE] = clip(swing_knee_torque_over_k(knee, knee_start, knee_end, 20), knee_limit)
-    s[a_st + KNEE] = clip(-law[L_STANCE_KNEE], knee_limit)
-    ankle_limit = body[B_ANKLE_EFFORT]
-    for leg, i, a in ((swing, sw_i, a_sw), (stance, st_i, a_st)):
-        foot_rate = pitch_rate + v[i] - v[i + KNEE] + v[i + ANKLE]
-        slope = ground_slope_k(law, leg[_ANKLE_X])
-        s[a + ANKLE] = clip(ankle_torque_k(law[L_ANKLE_KP], law[L_ANKLE_KD], leg[_FOOT], foot_rate, slope),
-                            ankle_limit)
-
-    # The hips: the swing hip drives the swing (servo or motor), gated; the stance hip holds the torso.
-    hip_limit = body[B_HIP_EFFORT]
-    torso = torso_torque_k(law[L_TORSO_KP], law[L_TORSO_KD], law[L_TORSO_PITCH], pitch, pitch_rate)
-    if law[L_MOTOR_PLANT] != 0.0:
-        # The plant's motor: the swing hip's actuator drives its joint's rate to zeta inside the plant's step,
-        # bounded by the motor's limit times the part of the period outside the window (0 inside it); the
-        # stance hip's actuator is a plain torque, the torso's law less the torque the swing hip's actuator
-        # applied over the last period (s[a_sw] holds it: `realized_hip_torques_k`).
-        sw_leg, st_leg = (sw_i - Q_HIP_LEFT) // 3, (st_i - Q_HIP_LEFT) // 3
-        reaction = s[a_sw]
-        s[a_sw] = 0.0
-        s[MOTOR_GAIN + sw_leg] = law[L_MOTOR_GAIN]
-        s[MOTOR_TARGET + sw_leg] = zeta
-        s[MOTOR_BOUND + sw_leg] = (1.0 - free) * min(law[L_MOTOR_LIMIT], hip_limit)
-        s[MOTOR_GAIN + st_leg] = MOTOR_OFF_GAIN
-        s[MOTOR_TARGET + st_leg] = v[st_i]
-        s[MOTOR_BOUND + st_leg] = hip_limit
-        s[a_st] = clip(torso - reaction, hip_limit)
-        return
-    if law[L_MOTOR] != 0.0:
-        # ODE's motor: the torque that brings the coordinate's rate to zeta by the update's end, from the
-        # plant's dynamics and what the last update's model missed (the disturbance: the joint limits' and the
-        # other contacts' forces, the contact's compliance), clipped to the motor's limit; the model's rate of
-        # the torque applied is kept for the next update to measure the disturbance by.
-        others = np.zeros(9)
-        for i in range(6):
-            if i % 3 != 0:  # knees and ankles, set above
-                others[3 + i] = s[TAU + i]
-        rate, gain, offset = motor_model_k(law, dyn, v, dt, sw_i, st_i, others, torso)
-        drive = 0.0
-        if gain > 0.0:
-            # the part of the rate's miss this update closes: all of it (ODE's motor at its step), or dt / T of it
-            # (a motor of time constant T, whose loop does not stiffen as the step shrinks)
-            part = 1.0 if law[L_MOTOR_TAU] <= dt else dt / law[L_MOTOR_TAU]
-            drive = clip(part * (zeta - rate - s[MOTOR_DISTURBANCE]) / gain, law[L_MOTOR_LIMIT])
-        tau_swing_hip = 0.0 if free >= 1.0 else (1.0 - free) * clip(offset + drive, hip_limit)
-        s[MOTOR_MODEL_RATE] = rate + gain * (tau_swing_hip - offset)
-    elif free >= 1.0:
-        tau_swing_hip = 0.0
-    else:
-        s[INTEGRAL] += angle_error * dt * (1.0 - free)
-        tau_swing_hip = (1.0 - free) * clip(
-            hip_servo_torque_k(law[L_HIP_KP], law[L_HIP_KD], law[L_HIP_KI], angle_error, zeta - swing_rate,
-                               s[INTEGRAL]), hip_limit)
-    s[a_sw] = tau_swing_hip
-    s[a_st] = clip(torso - tau_swing_hip, hip_limit)
-
-
-@njit
-def control_step(law, body, t: float, x, s, tau, row, dyn, command) -> int:
-    """One control update at context time t: reads the plant state x (q, v), advances the controller state
-    s (CONTROLLER_STATE) in place and writes the torques for the coming period into tau (6). Returns a
-    code of TOUCHED (a touchdown was confirmed: `row` holds its index and its TOUCHDOWN fields), FELL,
-    DONE_BIT and MOTORS. `dyn`: the plant's dynamics at x (DYN_*) where the controller solves the hip motor, else unread;
-    `command`: the plant's motor command (MOTOR_COMMAND_SIZE), written where the plant solves it."""
-    dt = law[L_DT]
-    now = t + law[L_LAG]  # the time of the plant state read (see "Timing")
-    s[STATE_TIME] = now
-    q, v = x[:9], x[9:]
-    q_prev = s[Q_PREV : Q_PREV + 6].copy()
-    pitch_prev = s[PREV_PITCH]
-    code = 0
-
-    # Work done by the held torques since the last update: tau is constant over the interval,
-    # so its work on each joint is exactly tau * (q_now - q_prev). The plant's motors: the torque they applied.
-    held_gains = (s[MOTOR_GAIN], s[MOTOR_GAIN + 1])
-    held_bounds = (s[MOTOR_BOUND], s[MOTOR_BOUND + 1])
-    if law[L_MOTOR_PLANT] != 0.0:
-        realized_hip_torques_k(s, v, tau)
-    total = 0.0
-    for i in range(18):
-        total += x[i]
-    # The work by role (model.ROLES): each period for the roles the legs held when it began (a period the roles swap
-    # inside counts for the roles before the swap).
-    held_right = s[STANCE_RIGHT] > 0.5
-    for i in range(6):
-        w = s[TAU + i] * (q[3 + i] - q_prev[i])
-        s[SIGNED_WORK + i] += w
-        role = 2 * (i % 3) + (1 if (i >= 3) == held_right else 0)  # ROLES: swing, then stance, of each joint
-        if w > 0.0:
-            s[POSITIVE_WORK + i] += w
-            s[ROLE_POSITIVE + role] += w
-        else:
-            s[ROLE_NEGATIVE + role] += w
-        s[Q_PREV + i] = q[3 + i]
-
-    if not math.isfinite(total):  # a NaN or an infinity anywhere makes the sum non-finite
-        s[FALL] = 4.0
-        for i in range(6):
-            s[TAU + i] = 0.0
-            tau[i] = 0.0
-        return FELL
-
-    px, pz, pitch = q[0], q[1], q[2]
-    pitch_rate = v[2]
-    s[PREV_PITCH] = pitch
-    left = leg_points_k(body, px, pz, pitch, q[3], q[4], q[5])
-    right = leg_points_k(body, px, pz, pitch, q[6], q[7], q[8])
-    entrained = law[L_ENTRAINED] != 0.0
-    stance_right = s[STANCE_RIGHT] > 0.5
-    st_i, sw_i, stance, swing = legs_k(stance_right, left, right)
-    # The legs by contact (the foot that landed last, and the other): the same as the roles but under the
-    # entrained phase reading, where the phase swaps the roles and a touchdown only marks T_n.
-    contact_right = s[CONTACT_RIGHT] > 0.5
-    cst_i, csw_i, c_stance, c_swing = legs_k(contact_right, left, right)
-    if law[L_MOTOR] != 0.0 and s[MOTOR_MODEL_RATE] == s[MOTOR_MODEL_RATE]:  # the motor's model, measured
-        missed = motor_coordinate_k(law, v, sw_i, st_i) - s[MOTOR_MODEL_RATE]
-        s[MOTOR_DISTURBANCE] += MOTOR_DISTURBANCE_GAIN * (missed - s[MOTOR_DISTURBANCE])
-    com_x = center_of_mass_k(body, px, pz, pitch, left, right)[0]
-    s[COM_X] = com_x
-
-    # Touchdown: record the section state and start the step's clock; under the reset reading, swap the
-    # roles and reset the CPG phase too (phase resetting).
-    clearance = min(c_swing[_HEEL_Z] - ground_height_k(law, c_swing[_HEEL_X]),
-                    c_swing[_TOE_Z] - ground_height_k(law, c_swing[_TOE_X]))
-    advance = c_swing[_ANKLE_X] - c_stance[_ANKLE_X]
-    c_prev = s[PREV_CLEARANCE]
-    s[PREV_CLEARANCE] = clearance
-    rate_1, rate_2 = s[PREV_RATES], s[PREV_RATES + 1]
-    s[PREV_RATES + 1] = rate_1
-    s[PREV_RATES] = v[csw_i] - v[cst_i]  # the section rate, were the swing foot to land now
-    rule = (law[L_TOUCHDOWN], law[L_TOUCHDOWN + 1], law[L_TOUCHDOWN + 2], law[L_TOUCHDOWN + 3])
-    touched = is_touchdown_k(rule, now - s[STEP_START], clearance, advance, s[GAMMA])
-    if touched:
-        contact_right = not contact_right
-        cst_i, csw_i = csw_i, cst_i
-        c_stance, c_swing = c_swing, c_stance
-        # T_n: the moment the clearance crossed the touchdown height, linearly between this update and
-        # the previous one, when the crossing is what confirmed the touchdown (otherwise this update).
-        back = 0.0
-        thr = rule[1]
-        crossed = math.isfinite(c_prev) and c_prev > thr >= clearance
-        if crossed:
-            back = (1.0 - (c_prev - thr) / (c_prev - clearance)) * dt
-        f = back / dt  # how far back towards the previous update T_n lies
-        angle = (1.0 - f) * (q[cst_i] - q[csw_i]) + f * (q_prev[cst_i - 3] - q_prev[csw_i - 3])
-        if crossed and math.isfinite(rate_2):
-            # both rates were read before the foot reached the ground: extrapolate them to T_n
-            rate = rate_1 + (rate_1 - rate_2) * (1.0 - f)
-        else:
-            rate = v[cst_i] - v[csw_i]
-        step_start = now - back
-        n = s[STEP_COUNT]
-        row[0] = n
-        row[1] = step_start
-        row[2] = angle
-        row[3] = rate
-        row[4] = 1.0 if contact_right else 0.0
-        row[5] = com_x
-        row[6] = 0.0
-        for i in range(6):
-            row[6] += s[POSITIVE_WORK + i]
-        code |= TOUCHED
-        s[CONTACT_RIGHT] = 1.0 if contact_right else 0.0
-        s[STEP_START] = step_start
-        s[STEP_COUNT] = n + 1.0
-        s[PREV_CLEARANCE] = math.inf  # the next swing foot's clearance is not yet known
-        s[PREV_RATES] = math.nan
-        s[PREV_RATES + 1] = math.nan
-        if not entrained:
-            stance_right = contact_right
-            st_i, sw_i = cst_i, csw_i
-            stance, swing = c_stance, c_swing
-            s[STANCE_RIGHT] = 1.0 if stance_right else 0.0
-            # the new swing thigh's world angle at T_n
-            s[LIFTOFF_ANGLE] = (1.0 - f) * swing[_THIGH] + f * (pitch_prev + q_prev[sw_i - 3])
-            s[GAMMA] = advance_phase_k(law[L_UR], law[L_KAPPA], 0.0, v[st_i + ANKLE], back)  # the phase since T_n
-            s[INTEGRAL] = 0.0
-            s[TRAVEL] = back * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.5 * s[GAMMA])
-            s[MOTOR_MODEL_RATE] = math.nan  # the motor drives the other legs' coordinate from here
-            s[MOTOR_DISTURBANCE] = 0.0
-
-    # A touchdown predicted inside the coming period (the clearance extrapolated over it crosses the
-    # touchdown height) swaps the roles at its own time: the period's torques blend the present roles'
-    # and the new roles' by the part of the period each holds, so the swap's impulse is continuous in
-    # the state. The swap itself is recorded at the next update, from the crossing it then sees.
-    # Under the entrained reading the roles swap where the phase crosses pi inside the coming period, with
-    # the same blend; the new half-cycle's phase runs on from there, and the state is the new roles' at once.
-    swap = -1.0
-    crossing = False
-    if entrained:
-        rate = phase_rate_k(law[L_UR], law[L_KAPPA], v[st_i + ANKLE])
-        if rate > 0.0 and s[GAMMA] + dt * rate >= math.pi:
-            swap = (math.pi - s[GAMMA]) / (dt * rate)
-            crossing = True
-    elif not touched and law[L_PREDICTED] != 0.0:
-        swap = predicted_touchdown_k(law, s, now, clearance, c_prev, advance, v[st_i + ANKLE])
-    if swap >= 0.0:
-        new = s.copy()
-        new[STANCE_RIGHT] = 0.0 if stance_right else 1.0
-        new[LIFTOFF_ANGLE] = stance[_THIGH] + swap * dt * (pitch_rate + v[st_i])
-        if not crossing:
-            new[STEP_START] = now + swap * dt
-            new[STEP_COUNT] = s[STEP_COUNT] + 1.0
-        # the phase and the travel from T_n: negative now, so that after the period they are the part of
-        # it after T_n
-        new[GAMMA] = -swap * dt * phase_rate_k(law[L_UR], law[L_KAPPA], v[sw_i + ANKLE])
-        new[TRAVEL] = -swap * dt * output_k(law[L_ALPHA], law[L_UA], law[L_UETA], 0.0)
-        new[INTEGRAL] = 0.0
-        new[MOTOR_DISTURBANCE] = 0.0
-        period_torques_k(law, body, new, q, v, now, not stance_right, swing, stance, dyn)
-    period_torques_k(law, body, s, q, v, now, stance_right, stance, swing, dyn)
-    if swap >= 0.0:
-        for i in range(TAU, TAU + 6):
-            s[i] = swap * s[i] + (1.0 - swap) * new[i]
-        for i in range(MOTOR_GAIN, MOTOR_BOUND + 2):  # the plant's motors too: each hip's by its part
-            s[i] = swap * s[i] + (1.0 - swap) * new[i]
-        if crossing:
-            for i in range(N_STATE):
-                if (i < TAU or i >= TAU + 6) and (i < MOTOR_GAIN or i >= MOTOR_BOUND + 2):
-                    s[i] = new[i]
-
-    # Fall detection and the end of the episode.
-    if left[_HIP_Z] - ground_height_k(law, left[_HIP_X]) < law[L_FALL_HEIGHT]:  # the hip joint's height
-        s[FALL] = 1.0
-    elif abs(pitch) > law[L_FALL_PITCH]:
-        s[FALL] = 2.0
-    elif min(left[_KNEE_Z] - ground_height_k(law, left[_KNEE_X]),
-             right[_KNEE_Z] - ground_height_k(law, right[_KNEE_X])) < 0.0:
-        s[FALL] = 3.0
-    if com_x >= s[TARGET_X]:
-        s[DONE] = 1.0
-    reversed_ = False
-    for i in range(6):
-        limit = body[B_HIP_EFFORT] if i % 3 == 0 else (body[B_KNEE_EFFORT] if i % 3 == 1 else body[B_ANKLE_EFFORT])
-        if abs(s[TAU + i] - tau[i]) > REVERSAL_FACTOR * limit:
-            reversed_ = True
-        tau[i] = s[TAU + i]
-    if law[L_MOTOR_PLANT] != 0.0:
-        for leg in range(2):
-            command[MOTOR_COMMAND_SIZE // 2 + 3 * leg] = s[MOTOR_TARGET + leg]
-            if s[MOTOR_GAIN + leg] != held_gains[leg] or s[MOTOR_BOUND + leg] != held_bounds[leg]:
-                code |= MOTORS
-    if reversed_:  # one reversal per update, however many joints jumped
-        s[REVERSALS] += 1.0
-        for j in range(DIVERGED_REVERSALS - 1, 0, -1):
-            s[RECENT_REVERSALS + j] = s[RECENT_REVERSALS + j - 1]
-        s[RECENT_REVERSALS] = now
-    oldest = s[RECENT_REVERSALS + DIVERGED_REVERSALS - 1]
-    if s[FALL] == 0.0 and now - oldest < (DIVERGENCE_SPAN_PERIODS - 0.5) * dt:
-        s[FALL] = 5.0
-    if s[FALL] != 0.0:
-        code |= FELL
-    if s[DONE] != 0.0:
-        code |= DONE_BIT
-    return code
-
-
-KNEE_STOP_RAD = 1e-3  # a knee within this of full extension (its stop, params.KNEE_LIMIT_RAD[0] = 0) is at it
-
-
-class _PlantDynamics:
-    """The plant's dynamics at a state, as the hip motor reads them (DYN_*), through a context of the plant's
-    own: the mass matrix, the stance foot's contact rows (its heel's x and z, its toe's z, at the soles'
-    lowest points) and gravity minus the bias term."""
-
-    def __init__(self, plant, body: np.ndarray):
-        from pydrake.multibody.tree import JacobianWrtVariable
-
-        from drake_biped.kinematics import B_HEEL_SOLE, B_HEEL_X, B_TOE_SOLE, B_TOE_X
-
-        self._plant = plant
-        self._context = plant.CreateDefaultContext()
-        self._feet = {right: plant.GetBodyByName(f"{'right' if right else 'left'}_foot").body_frame()
-                      for right in (False, True)}
-        self._points = np.array([[body[B_HEEL_X], 0.0, body[B_HEEL_SOLE]], [body[B_TOE_X], 0.0, body[B_TOE_SOLE]]]).T
-        self._kv = JacobianWrtVariable.kV
-        self._knees = [3 + joint_index(leg, "knee") for leg in LEGS]
-
-    def fill(self, dyn: np.ndarray, x: np.ndarray, stance_right: bool, torques: np.ndarray) -> None:
-        plant, context = self._plant, self._context
-        plant.SetPositionsAndVelocities(context, x)
-        dyn[DYN_M : DYN_M + 81] = plant.CalcMassMatrix(context).ravel()
-        world = plant.world_frame()
-        jac = plant.CalcJacobianTranslationalVelocity(context, self._kv, self._feet[stance_right], self._points,
-                                                      world, world)
-        dyn[DYN_J : DYN_J + 27] = jac[[0, 2, 5]].ravel()  # heel x, heel z, toe z
-        rows = 3
-        for k in self._knees:  # a knee at its stop with an extending torque held holds there
-            if x[k] <= KNEE_STOP_RAD and torques[k - 3] < 0.0:
-                dyn[DYN_J + 9 * rows : DYN_J + 9 * rows + 9] = 0.0
-                dyn[DYN_J + 9 * rows + k] = 1.0
-                rows += 1
-        dyn[DYN_N] = rows
-        dyn[DYN_F : DYN_F + 9] = plant.CalcGravityGeneralizedForces(context) - plant.CalcBiasTerm(context)
-
-
-class _PlantMotors:
+class PlantMotors:
     """The plant's hip actuators as the plant's hip motor drives them (motor_solve "plant"): their velocity gains
     and effort limits, set between the plant's steps whenever the controller's state changes them. Drake reads
     an actuator's gains and limit at each step, from the plant's model, not from a Context: so one plant serves
@@ -913,9 +109,11 @@ class _PlantMotors:
             raise ValueError(f"the plant's hip actuators: expected {[f'{leg}_hip' for leg in LEGS]}, got {names}")
         self._applied = [[math.nan, math.nan] for _ in self._hips]
 
-    def apply(self, s: np.ndarray) -> None:
+    def apply(self, gains: np.ndarray, bounds: np.ndarray) -> None:
+        """Give the left and the right hip's actuator `gains[leg]` (N*m*s/rad) and the torque bound `bounds[leg]`
+        (N*m; 0: no torque), where they changed."""
         for leg, actuator in enumerate(self._hips):
-            gain, bound = s[MOTOR_GAIN + leg], s[MOTOR_BOUND + leg]
+            gain, bound = gains[leg], bounds[leg]
             applied = self._applied[leg]
             if gain != applied[0]:
                 actuator.set_controller_gains(self._gains(p=0.0, d=gain))
@@ -925,9 +123,6 @@ class _PlantMotors:
                 # rounds to zero; the update counts zero)
                 actuator.set_effort_limit(max(bound, MOTOR_NO_TORQUE))
                 applied[1] = bound
-
-
-MOTOR_NO_TORQUE = math.ulp(0.0)
 
 
 class CpgWalkingController(LeafSystem):
@@ -942,8 +137,8 @@ class CpgWalkingController(LeafSystem):
         reads at each update through a context of its own (None: no motor)."""
         super().__init__()
         self._dyn = np.zeros(DYN_SIZE)
-        self._dynamics = None if plant is None else _PlantDynamics(plant, body)
-        self._motors = None if plant is None else _PlantMotors(plant)
+        self._dynamics = None if plant is None else PlantDynamics(plant, body)
+        self._motors = None if plant is None else PlantMotors(plant)
         body = np.asarray(body, dtype=float)
         if body.shape != (BODY.size,):
             raise ValueError(f"body: expected a kinematics.BODY vector of {BODY.size}, got shape {body.shape}")
@@ -981,7 +176,7 @@ class CpgWalkingController(LeafSystem):
         """What the system's ports, state sizes and update period are built from."""
         sim = config.sim
         return (config.ground, sim.time_step_s, sim.update_period_s, sim.max_time_s, config.gait.touchdown_min_step_s,
-                plant_motor(config))
+                config.gait.plant_motor)
 
     def set_episode(self, context, config: EpisodeConfig) -> None:
         """Put the per-episode numbers (CPG, gait, window, fall thresholds) of `config` into this system's
@@ -1045,7 +240,7 @@ class CpgWalkingController(LeafSystem):
         period (motor_solve "plant"; nothing otherwise): call after every update, and once an episode's initial
         state is set, before the plant's first step."""
         if law[L_MOTOR_PLANT] != 0.0:
-            self._motors.apply(s)
+            self._motors.apply(s[MOTOR_GAIN : MOTOR_GAIN + 2], s[MOTOR_BOUND : MOTOR_BOUND + 2])
 
     @property
     def torque_group(self) -> int:
@@ -1091,7 +286,7 @@ class CpgWalkingController(LeafSystem):
 
     def motor_dynamics(self, law: np.ndarray, x: np.ndarray, s: np.ndarray) -> np.ndarray:
         """The `dyn` argument of `control_step` for the plant state x and controller state s: the plant's
-        dynamics where the law's hip is a motor (`_PlantDynamics`), else the unread zeros."""
+        dynamics where the law's hip is a motor (`hip_motor.PlantDynamics`), else the unread zeros."""
         if law[L_MOTOR] == 0.0 or law[L_MOTOR_PLANT] != 0.0:
             return self._dyn
         if self._dynamics is None:

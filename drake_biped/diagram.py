@@ -13,7 +13,8 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, VectorLogSink
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_biped.controller import MOTOR_OFF_GAIN, CpgWalkingController, plant_motor
+from drake_biped.controller import CpgWalkingController
+from drake_biped.hip_motor import MOTOR_OFF_GAIN
 from drake_biped.kinematics import TABLE_I_BODY, LinkMasses, leg_points, masses_of
 from drake_biped.model import add_biped
 from drake_biped.params import EpisodeConfig, Push
@@ -106,7 +107,7 @@ def build_diagram(
     controller = builder.AddNamedSystem("cpg_controller", CpgWalkingController(config, handles.body, plant))
     builder.Connect(plant.get_state_output_port(), controller.get_input_port_plant_state())
     builder.Connect(controller.get_output_port_actuation(), plant.get_actuation_input_port())
-    if plant_motor(config):  # the hips' actuators are the motor's, inside the plant's step
+    if config.gait.plant_motor:  # the hips' actuators are the motor's, inside the plant's step
         from pydrake.multibody.tree import PdControllerGains
 
         hips = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices()
@@ -125,7 +126,7 @@ def build_diagram(
             ("state_log", plant.get_state_output_port()),
             ("controller_log", controller.get_output_port_controller_state()),
             # the torques the plant applied: its motors' included, where it solves the hip motor
-            ("actuation_log", plant.get_net_actuation_output_port() if plant_motor(config)
+            ("actuation_log", plant.get_net_actuation_output_port() if config.gait.plant_motor
              else controller.get_output_port_actuation()),
         ):
             logs[name] = LogVectorOutput(port, builder, period)
@@ -138,7 +139,7 @@ def build_diagram(
         )
     diagram = builder.Build()
     diagram.set_name("drake_biped")
-    return BipedDiagram(diagram, plant, controller, handles.body, **logs, actuation_applied=plant_motor(config))
+    return BipedDiagram(diagram, plant, controller, handles.body, **logs, actuation_applied=config.gait.plant_motor)
 
 
 def build_replay_diagram(

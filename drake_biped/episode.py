@@ -16,9 +16,10 @@ import numpy as np
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
-from drake_biped import controller as ctl
+from drake_biped import control_kernel as ctl
 from drake_biped.analysis.cost_of_transport import cost_of_transport, cost_of_transport_per_kg
 from drake_biped.analysis.long_run import BATCHES, TRANSIENT_M, long_run_cost
+from drake_biped.control_law import L_MOTOR, L_MOTOR_PLANT
 from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import BipedDiagram, build_diagram, initial_state
 from drake_biped.kinematics import center_of_mass
@@ -323,9 +324,9 @@ def _step_directly(parts: BipedDiagram, root, config: EpisodeConfig, progress, k
     touchdowns = ctrl_ctx.get_mutable_discrete_state(controller.touchdown_group).get_mutable_value()
     command = ctrl_ctx.get_mutable_discrete_state(controller.command_group).get_mutable_value()
     law, body, row = controller.kernel_arguments(ctrl_ctx)
-    plant_motor = law[ctl.L_MOTOR_PLANT] != 0.0  # the plant's hip motors take their gains after each update
+    plant_motor = law[L_MOTOR_PLANT] != 0.0  # the plant's hip motors take their gains after each update
     apply_motors = controller.apply_motors
-    motor = law[ctl.L_MOTOR] != 0.0 and not plant_motor  # the controller's motor reads the plant's dynamics
+    motor = law[L_MOTOR] != 0.0 and not plant_motor  # the controller's motor reads the plant's dynamics
     dyn = controller.motor_dynamics(law, x, s)
     store = controller.store_touchdown
     torques = controller.torque_group

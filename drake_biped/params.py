@@ -65,7 +65,7 @@ def _is_number(value: Any) -> bool:
 def param(default: Any, unit: str, doc: str, lo: float | None = None, hi: float | None = None) -> Any:
     """A parameter declared once: its default, its unit ("1" for a pure number, "" for a choice or a flag),
     what it means and its bounds (None: unbounded on that side), as Drake's named vectors declare theirs. The
-    dataclass checks the bounds; the controller's Context parameter (controller.LAW) and docs/PARAMETERS.md
+    dataclass checks the bounds; the controller's Context parameter (control_law.LAW) and docs/PARAMETERS.md
     read the unit and the text from here."""
     return field(default=default, metadata={"unit": unit, "doc": doc, "bounds": (lo, hi)})
 
@@ -358,6 +358,12 @@ class GaitParams(_Validated):
     UNREAD_BY_PLANT_MOTOR = ("motor_time_constant_s",)
     UNREAD_BY_CONTROLLER_MOTOR = ("motor_gain_nms",)
     UNREAD_BY_ENTRAINED = ("touchdown_min_phase",)  # the phase does not follow the steps
+
+    @property
+    def plant_motor(self) -> bool:
+        """Whether the plant solves the hip motor (hip_drive "motor", motor_solve "plant"): its hips are then
+        PD-controlled actuators, driven through the controller's "motor_command" output."""
+        return self.hip_drive == "motor" and self.motor_solve == "plant"
 
     def unread(self) -> tuple[str, ...]:
         """The fields this gait's readings leave unread (`hip_drive`, `phase_reading`): a value given to one

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from pydrake.systems.analysis import Simulator
 
-from drake_biped import controller as ctl
+from drake_biped import control_kernel as ctl
 from drake_biped.diagram import build_diagram
 from drake_biped.episode import reset_context
 from drake_biped.kinematics import B_ANKLE_X, B_ANKLE_Z, B_KNEE_X, B_KNEE_Z, TABLE_I_BODY, leg_points

@@ -76,7 +76,7 @@ def test_shipped_gaits_load_by_name_or_path(tmp_path):
 
 
 def test_controller_state_is_read_by_name():
-    from drake_biped.controller import CONTROLLER_STATE, N_STATE, POSITIVE_WORK, TAU
+    from drake_biped.control_kernel import CONTROLLER_STATE, N_STATE, POSITIVE_WORK, TAU
 
     assert N_STATE == CONTROLLER_STATE.size == 68
     assert CONTROLLER_STATE.slice("torques_nm") == slice(TAU, TAU + 6)

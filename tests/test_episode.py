@@ -209,7 +209,7 @@ def test_a_diverging_control_loop_is_named_diverged_not_a_fall():
     """At a 10 ms control period the servos chatter between their limits (the work 2273 J in 0.94 s, C_mt
     803, was reported as an ordinary fall): the episode now ends as 'diverged' at the fifth torque reversal,
     while the walk at 1 ms has none."""
-    from drake_biped import controller as ctl
+    from drake_biped import control_kernel as ctl
 
     coarse = run_episode(EpisodeConfig().override({"sim.time_step_s": 0.01, "sim.control_period_s": 0.01,
                                                    "sim.distance_m": 1.0}))

@@ -263,7 +263,7 @@ def test_a_restart_from_an_update_continues_the_walk_exactly(biped_map):
     """The map's restart (defaults, then the plant, torques and controller state set) loses nothing: from a
     snapshot taken at an update, with its clocks moved to time 0, the walk to the next section is the
     walk that continued, to the bit."""
-    from drake_biped import controller as ctl
+    from drake_biped import control_kernel as ctl
     from drake_biped.step_map import Snapshot
 
     section_map, z0, template = biped_map
@@ -284,7 +284,7 @@ def test_a_restart_from_an_update_continues_the_walk_exactly(biped_map):
 
 @pytest.mark.slow
 def test_the_held_slots_do_not_change_the_map(biped_map):
-    from drake_biped import controller as ctl
+    from drake_biped import control_kernel as ctl
     from drake_biped.step_map import Snapshot
 
     section_map, z0, template = biped_map

@@ -7,7 +7,7 @@ applied."""
 import numpy as np
 import pytest
 
-import drake_biped.controller as ctl
+import drake_biped.control_kernel as ctl
 from drake_biped.cpg import output
 from drake_biped.diagram import build_diagram
 from drake_biped.episode import reset_context, run_episode

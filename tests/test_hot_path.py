@@ -5,6 +5,8 @@ import pytest
 from pydrake.systems.analysis import Simulator
 
 from drake_biped import controller as ctl
+from drake_biped.control_kernel import MAX_TOUCHDOWNS, touchdown_capacity
+from drake_biped.control_law import L_T1
 from drake_biped.diagram import build_diagram, build_replay_diagram, initial_state
 from drake_biped.episode import DiagramCache, run_episode
 from drake_biped.kinematics import center_of_mass
@@ -133,8 +135,8 @@ def test_loggers_are_built_only_when_recording():
 def test_touchdown_capacity_covers_the_longest_episode():
     config = _config()
     need = config.sim.max_time_s / config.gait.touchdown_min_step_s
-    assert ctl.touchdown_capacity(config) >= need
-    assert ctl.touchdown_capacity(config) <= ctl.MAX_TOUCHDOWNS
+    assert touchdown_capacity(config) >= need
+    assert touchdown_capacity(config) <= MAX_TOUCHDOWNS
 
 
 def test_a_reused_diagram_gives_the_numbers_of_a_fresh_one():
@@ -169,7 +171,7 @@ def test_controller_refuses_a_config_of_another_structure():
     c = ctl.CpgWalkingController(config)
     context = c.CreateDefaultContext()
     c.set_episode(context, config.replace(window=TorqueFreeWindow(0.1, 0.3)))  # numbers only: fine
-    assert c.law(context)[ctl.L_T1] == 0.1 and c.law(c.CreateDefaultContext())[ctl.L_T1] == config.window.start_s
+    assert c.law(context)[L_T1] == 0.1 and c.law(c.CreateDefaultContext())[L_T1] == config.window.start_s
     with pytest.raises(ValueError, match="another ground"):
         c.set_episode(context, config.replace(ground=Ground(slope_rad=0.02)))
 
@@ -243,7 +245,7 @@ def _paper(distance: float = 1.5, **changes) -> EpisodeConfig:
 
 def test_the_plant_solved_motor_walks_the_simulators_numbers_stepped_directly(monkeypatch):
     """The paper's walker, its hip motor solved in the plant's step (its actuators' gains and bounds set between
-    steps: controller._PlantMotors), stepped directly and by the Simulator: the same walk to the last bit, with a
+    steps: controller.PlantMotors), stepped directly and by the Simulator: the same walk to the last bit, with a
     window (the bound drops to zero and back), across touchdowns (the roles' actuators swap) and with a kick."""
     config = _paper().replace(window=TorqueFreeWindow(0.1, 0.2))
     assert config.gait.motor_solve == "plant"

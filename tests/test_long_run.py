@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from drake_biped.analysis.long_run import long_run_cost, t975
+from drake_biped.hip_motor import DYN_SIZE
 
 
 def _walk(steps, period=0.5, length=0.4, work=20.0, start_x=0.0):
@@ -54,7 +55,8 @@ def test_a_walk_too_short_for_its_batches_has_no_long_run_cost():
 
 
 def _kernel_inputs():
-    from drake_biped import controller as ctl
+    from drake_biped import control_kernel as ctl
+    from drake_biped.controller import law_vector
     from drake_biped.diagram import initial_state
     from drake_biped.kinematics import TABLE_I_BODY
     from drake_biped.params import EpisodeConfig
@@ -69,7 +71,7 @@ def _kernel_inputs():
     s[ctl.PREV_RATES: ctl.PREV_RATES + 2] = math.nan
     s[ctl.RECENT_REVERSALS: ctl.RECENT_REVERSALS + ctl.DIVERGED_REVERSALS] = -math.inf
     s[ctl.Q_PREV: ctl.Q_PREV + 6] = q[3:]
-    return ctl, ctl.law_vector(config), TABLE_I_BODY, np.concatenate([q, v]), s
+    return ctl, law_vector(config), TABLE_I_BODY, np.concatenate([q, v]), s
 
 
 @pytest.mark.parametrize("every, diverges", [(1, True), (4, True), (5, False), (8, False)])
@@ -85,7 +87,8 @@ def test_divergence_is_a_rate_of_reversals_not_a_total(every, diverges):
     for k in range(60):
         if k % every == 0:
             tau[:] = 1e3  # the held torques far from what the update computes: a reversal
-        code = ctl.control_step(law, body, k * 1e-3, x, s, tau, row, np.zeros(ctl.DYN_SIZE), np.zeros(ctl.MOTOR_COMMAND_SIZE))
+        code = ctl.control_step(law, body, k * 1e-3, x, s, tau, row, np.zeros(DYN_SIZE),
+                                np.zeros(ctl.MOTOR_COMMAND_SIZE))
         if code & ctl.FELL:
             fell_at = k
             break

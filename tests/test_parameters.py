@@ -1,4 +1,4 @@
-"""One schema for the controller's numbers: every slot of its Context parameter (controller.LAW) has a doc and a
+"""One schema for the controller's numbers: every slot of its Context parameter (control_law.LAW) has a doc and a
 unit; the slots that copy the configuration take their declaration from params (`param`), whose bounds the
 dataclasses enforce; docs/PARAMETERS.md is generated from it."""
 
@@ -6,7 +6,8 @@ import math
 from dataclasses import fields
 from pathlib import Path
 
-from drake_biped import controller as ctl
+from drake_biped import control_law as ctl
+from drake_biped.controller import law_vector
 from drake_biped.params import EpisodeConfig, parameter_info
 
 
@@ -30,7 +31,7 @@ def test_copied_slots_carry_their_declaration_and_value():
     changed["window"]["end_s"] = changed["window"]["start_s"] + 0.1
     # every slot moved at once, the unread ones too (the servo leaves the motor's limit unread): a sampled point
     config = config.override({f"{s}.{n}": v for s, d in changed.items() for n, v in d.items()}, sampled=True)
-    law = ctl.law_vector(config)
+    law = law_vector(config)
     for section, name, slot in ctl.LAW_COPIED:
         field = ctl.LAW.fields[ctl.LAW.offset(slot)]
         info = parameter_info(type(getattr(config, section)), name)
@@ -40,7 +41,7 @@ def test_copied_slots_carry_their_declaration_and_value():
 
 def test_the_entrained_reading_drops_the_phase_condition():
     config = EpisodeConfig().override({"gait.phase_reading": "entrained"})
-    assert ctl.law_vector(config)[ctl.LAW.offset("touchdown_min_phase")] == -math.inf
+    assert law_vector(config)[ctl.LAW.offset("touchdown_min_phase")] == -math.inf
 
 
 def test_docs_table_is_current():

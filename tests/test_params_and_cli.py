@@ -117,7 +117,8 @@ def test_the_controller_clock_is_the_plant_step_by_default_and_every_record_name
     """The paper's clock (ODE's motors act inside every step): the controller's update period is the plant step,
     refined with it; a fixed-rate loop is a number kept over the step; a record holds the reading and the rate;
     an older record's control period is the fixed-rate loop it ran on."""
-    from drake_biped.controller import L_DT, law_vector
+    from drake_biped.control_law import L_DT
+    from drake_biped.controller import law_vector
     from drake_biped.params import clock_of_record, with_time_step
 
     config = EpisodeConfig().override({"sim.time_step_s": 2.5e-4})

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drake_biped.controller import DYN_F, DYN_J, DYN_M, DYN_N, DYN_SIZE, constrained_inverse_k
+from drake_biped.hip_motor import DYN_F, DYN_J, DYN_M, DYN_N, DYN_SIZE, constrained_inverse_k
 from drake_biped.versions import CROSS_MACHINE_RTOL, MACHINE_IDENTITY, compare_with_record, machine, versions
 
 
