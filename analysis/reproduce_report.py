@@ -330,11 +330,11 @@ def table_iii_rank(out: Path) -> tuple[int, int] | None:
 
 
 def gait_label(gait: str) -> str:
-    """How the report names the gait a run walks: "the default gait", "the `paper` gait"."""
-    return "the default gait" if gait == "default" else f"the `{gait}` gait"
+    """How the report names the gait a run walks: "the `paper` gait", "the `fast_servo` gait"."""
+    return f"the `{gait}` gait"
 
 
-def walk_section(walk: dict[str, Any], gait: str = "default") -> list[str]:
+def walk_section(walk: dict[str, Any], gait: str = "paper") -> list[str]:
     """The report's section on the gait's walk (`walk/`), from its summary."""
     return [
         "## The walk (`walk/`)",
@@ -350,7 +350,7 @@ def walk_section(walk: dict[str, Any], gait: str = "default") -> list[str]:
 
 
 def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any],
-                    gait: str = "default", choices: str = "") -> tuple[str, list]:
+                    gait: str = "paper", choices: str = "") -> tuple[str, list]:
     label = gait_label(gait)
     window = tuple(s["push_margin"]["settings"]["window"])  # the learned window (Reproduction.learned_window)
     source = s["push_margin"]["window_source"]
@@ -421,7 +421,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"resumed, is not counted). drake-biped {code.get('drake_biped')} ({code.get('git_commit')}), Drake "
         f"{code.get('drake')}. Paper: Takita, Azuma & Shibata, *Acquisition of Energy-Efficient Bipedal Walking "
         "Using CPG-Based Reinforcement Learning*. Every claim is measured on one gait, "
-        + ("the default" if gait == "default" else f"`{gait}`") + " (its "
+        + f"`{gait}`" + " (its "
         f"plant step {_ms(s['learn']['settings']['config'])}), with one torque-free window: {wtext}, {source}. Each row "
         f"links to its section, each number in the folder named there. {provenance_text(s)}"
         + (f" What this gait's story chooses where the paper prints nothing: {choices}." if choices else ""),
@@ -541,7 +541,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                 "placement gain and u_a, u_r, κ raised as Table VII raises them; the 2.0° story runs on the grid's "
                 f"best ({label} itself when no point climbs).",
                 "",
-                f"| parameter | paper: Table III → Table VII | ours: {'default' if gait == 'default' else gait} → "
+                f"| parameter | paper: Table III → Table VII | ours: {gait} → "
                 + ("2.0° best |" if climbs_2deg(g2) else "the furthest fall (nothing climbs) |"),
                 "|---|---|---|",
                 *vii_rows,
@@ -579,7 +579,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     return "\n".join(lines), verdicts
 
 
-def other_gaits_section(gait: str = "default") -> list[str]:
+def other_gaits_section(gait: str = "paper") -> list[str]:
     """The report's closing section: the shipped gaits other than the run's, and why each exists."""
     from drake_biped.resources import gait_about, gait_names
 
@@ -599,11 +599,11 @@ VERDICT_COLOURS = ((REPRODUCED, "#c8e6c9"), (PARTLY, "#ffe0b2"), (DIFFERS, "#ffe
 def window_name(source: str) -> str:
     """What the story's window is, in words, from where it came (Reproduction.learned_window's source): "the
     learned window" when a trial learned it, else "the window map's cheapest window", else (no window of the map
-    walks) "the default gait's learned window"."""
+    walks) "the window its gait file declares"."""
     if source.startswith("learned"):
         return "the learned window"
     return "the window map's cheapest window" if source.startswith("the window map") else \
-        "the default gait's learned window"
+        "the window its gait file declares"
 
 
 def _window_text(window) -> str:
@@ -715,7 +715,7 @@ def provenance_text(s: dict[str, dict[str, Any]]) -> str:
 
 
 def write_report(out: Path, summaries: dict[str, dict[str, Any]], profile: Any,
-                 code: dict[str, Any], full_run: dict[str, Any] | None = None, gait: str = "default",
+                 code: dict[str, Any], full_run: dict[str, Any] | None = None, gait: str = "paper",
                  choices: str = "") -> list[Path]:
     """report.md, report.html and report_summary.png of a run on `gait` (`choices`: what its story chooses
     where the paper prints nothing); a full run also writes verdicts.json (full_run_digest), which a quick run
@@ -781,18 +781,18 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
 
 
 # Where each gait's committed full run lives in the repository (its report, records and verdicts.json).
-FULL_RUN_RECORDS = {"default": "benchmarks/results/reproduce-full", "paper": "benchmarks/results/reproduce-paper"}
+FULL_RUN_RECORDS = {"fast_servo": "benchmarks/results/reproduce-full", "paper": "benchmarks/results/reproduce-paper"}
 
 
 def full_run_records(full_run: dict[str, Any] | None) -> str:
     """The repository folder of the shipped full run (FULL_RUN_RECORDS, by the gait its checks walked)."""
-    return FULL_RUN_RECORDS.get(full_run_gait_name(full_run) or "default", FULL_RUN_RECORDS["default"])
+    return FULL_RUN_RECORDS.get(full_run_gait_name(full_run) or "paper", FULL_RUN_RECORDS["paper"])
 
 
 def full_run_gait_name(full_run: dict[str, Any] | None) -> str | None:
     """The shipped gait (`--params NAME`) whose CPG, gains and initiation the full run's checks walked:
-    "default", another shipped gait's name, or None (another gait, or no checks recorded)."""
-    from drake_biped.params import config_of_record
+    "paper", another shipped gait's name, or None (another gait, or no checks recorded)."""
+    from drake_biped.legacy import config_of_record
     from drake_biped.resources import gait_names, load_gait
 
     configs = [c["config"] for c in (full_run or {}).get("checks", {}).values() if "config" in c]
@@ -802,13 +802,13 @@ def full_run_gait_name(full_run: dict[str, Any] | None) -> str | None:
         return config.cpg, config.gait.as_walked(), config.initial
 
     recorded = walked(config_of_record(configs[0]))  # a record older than a field reads its default
-    for name in sorted(gait_names(), key=lambda n: n != "default"):
+    for name in sorted(gait_names(), key=lambda n: n != "paper"):
         if recorded == walked(load_gait(name)):
             return name
     return None
 
 
-def full_run_gait(full_run: dict[str, Any] | None, gait: str = "default") -> str | None:
+def full_run_gait(full_run: dict[str, Any] | None, gait: str = "paper") -> str | None:
     """The gait the shipped full run was measured on, when it is not `gait` (the one this run walks): the
     shipped gait's name, quoted, else "another gait"; None when it is `gait` (or the full run records no
     checks)."""
@@ -821,7 +821,7 @@ def full_run_gait(full_run: dict[str, Any] | None, gait: str = "default") -> str
 
 
 def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code: dict[str, Any],
-                          full_run: dict[str, Any] | None, gait: str = "default") -> str:
+                          full_run: dict[str, Any] | None, gait: str = "paper") -> str:
     rows = quick_rows(s, full_run)
     wall = sum(x.get("wall_s") or 0.0 for x in s.values())
     other = full_run_gait(full_run, gait)

@@ -45,8 +45,8 @@ def report_summary(out: Path) -> Path:
 def walk_frame(out: Path) -> tuple[Path, str]:
     from drake_biped.analysis.figures import walk_frame as draw
     from drake_biped.episode import run_episode
+    from drake_biped.legacy import config_of_record
     from drake_biped.model import body_of_model
-    from drake_biped.params import config_of_record
     from drake_biped.versions import compare_with_record
 
     record = json.loads((FULL_RUN / "walk" / "result.json").read_text())

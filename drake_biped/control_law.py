@@ -147,7 +147,8 @@ def parameter_markdown() -> str:
             + LAW.markdown()
             + "\n## The episode's configuration\n\n"
             "Every field of `EpisodeConfig`'s sections, as a params file or `config.override({\"section.field\": "
-            "value})` names it, with the dataclass's default (`CpgParams()`; `EpisodeConfig()` takes the default gait's "
-            "CPG and gait sections, drake_biped/gaits/default.json, and a shipped gait file its own), unit, bounds "
+            "value})` names it, with the dataclass's default (`CpgParams()`: Table III; `GaitParams()`: the paper's "
+            "walker's gains; `EpisodeConfig()` is the paper's walker, drake_biped/gaits/paper.json, and a shipped gait "
+            "file its own), unit, bounds "
             "(the dataclass refuses a value outside them) and meaning. Unit `-`: a choice among named readings.\n"
             + configuration)

@@ -26,6 +26,7 @@ from drake_biped.kinematics import center_of_mass
 from drake_biped.model import JOINT_NAMES, ROLES, joint_index
 from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, ParameterError, SimulationParams
 from drake_biped.records import atomic_file, write_text_atomic
+from drake_biped.resources import gait_identity
 from drake_biped.versions import versions
 
 
@@ -79,6 +80,9 @@ class EpisodeResult:
     # swing knee, ...), each control period counted for the roles held when it began; None in a record written
     # before it was kept
     work_by_role: dict[str, dict[str, float]] | None = None
+    # which gait walked (resources.gait_identity): {"name": a shipped gait's or None, "sha256": the walker's digest};
+    # None in a record written before it was kept
+    gait: dict[str, str | None] | None = None
 
     @property
     def total_positive_work_j(self) -> float:
@@ -481,6 +485,7 @@ def run_episode(
         versions=versions(),
         trajectory=trajectory,
         work_by_role=by_role,
+        gait=gait_identity(config),
     )
 
 

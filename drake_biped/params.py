@@ -23,10 +23,10 @@ from drake_biped.paper import (
 
 __all__ = [
     "ContactParams", "CpgParams", "param", "parameter_info", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
-    "SHORT_NAMES", "SimulationParams", "config_of_record", "DRAKE_DEFAULT_CONTACT",
+    "SHORT_NAMES", "SimulationParams", "DRAKE_DEFAULT_CONTACT",
     "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "check_declared",
     "check_given", "check_window_given", "config_of_params", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
-    "LEARNED_WINDOW_S", "RobotModel",
+    "DEFAULT_INITIAL", "DEFAULT_SIM", "DEFAULT_WINDOW_S", "RobotModel",
 ]
 
 TOTAL_MASS_KG = TABLE_I_TOTAL_MASS_KG
@@ -143,9 +143,10 @@ class _Validated:
         return dataclasses.asdict(self)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any] | None, where: str | None = None):
+    def from_dict(cls, data: dict[str, Any] | None, where: str | None = None, base: Any = None):
         """An instance from a mapping of its fields (a JSON object); ParameterError naming `where` (default:
-        the class) for anything else, an unknown field or a bad value."""
+        the class) for anything else, an unknown field or a bad value. An EpisodeConfig's sections take their
+        missing fields from `base` (an EpisodeConfig; default `EpisodeConfig()`, the paper's walker)."""
         where = where or cls.__name__
         if data is None:
             data = {}
@@ -162,13 +163,14 @@ class _Validated:
         if unknown:
             raise ParameterError(f"{where}: unknown parameter(s) {unknown}; known: {sorted(known)}")
         kwargs = {}
-        defaults = cls() if cls is EpisodeConfig else None
+        defaults = (base if base is not None else cls()) if cls is EpisodeConfig else None
         for name, value in data.items():
             sub = _SECTIONS.get(name) if cls is EpisodeConfig else None
             if sub is not None:
                 inner = f"{where}.{name}" if where == cls.__name__ else f"{where}, section {name!r}"
-                # a section's missing fields are the default configuration's (the default gait's, not
-                # the class's), so that {"gait": {"hip_kd": 12}} is the default gait with one gain changed
+                # a section's missing fields are the base configuration's (the paper's walker's unless a
+                # record's reader gives its own), so that {"gait": {"torso_kd": 12}} is that gait with one gain
+                # changed
                 default = getattr(defaults, name)
                 if default is not None and isinstance(value, Mapping):
                     value = {**default.to_dict(), **value}
@@ -185,7 +187,7 @@ class _Validated:
 
 @dataclass(frozen=True)
 class CpgParams(_Validated):
-    """The CPG of eq. 2-3 with Table III's symbols.
+    """The CPG of eq. 2-3 with Table III's symbols; its defaults are Table III as printed (`paper.TABLE_III`).
 
     Phase: d(gamma)/dt = u_r + kappa * (stance ankle angular velocity).
     Output (desired swing-hip angular velocity, rad/s): zeta = alpha * u_a * sin(gamma) + u_eta.
@@ -194,11 +196,11 @@ class CpgParams(_Validated):
     """
 
     # Table IV's grid-search ranges bound what the toolkit accepts, widened for u_a and u_r.
-    alpha: float = param(1.0, "1", "CPG output gain alpha (Table III)", -2.0, 2.0)
-    u_a: float = param(2.0, "rad/s", "CPG amplitude u_a: zeta = alpha u_a sin(gamma) + u_eta", 0.0, 20.0)
-    u_eta: float = param(0.0, "rad/s", "CPG offset u_eta added to zeta", -1.0, 1.0)
-    u_r: float = param(2.1, "rad/s", "CPG phase rate u_r: d(gamma)/dt = u_r + kappa (stance ankle rate)", 1e-3, 30.0)
-    kappa: float = param(1.8, "1", "CPG feedback gain kappa on the stance ankle's angular velocity", -10.0, 10.0)
+    alpha: float = param(TABLE_III["alpha"], "1", "CPG output gain alpha (Table III)", -2.0, 2.0)
+    u_a: float = param(TABLE_III["u_a"], "rad/s", "CPG amplitude u_a: zeta = alpha u_a sin(gamma) + u_eta", 0.0, 20.0)
+    u_eta: float = param(TABLE_III["u_eta"], "rad/s", "CPG offset u_eta added to zeta", -1.0, 1.0)
+    u_r: float = param(TABLE_III["u_r"], "rad/s", "CPG phase rate u_r: d(gamma)/dt = u_r + kappa (stance ankle rate)", 1e-3, 30.0)
+    kappa: float = param(TABLE_III["kappa"], "1", "CPG feedback gain kappa on the stance ankle's angular velocity", -10.0, 10.0)
 
     @property
     def swing_amplitude_rad(self) -> float:
@@ -212,6 +214,11 @@ PAPER_CPG = CpgParams(**TABLE_III)  # Table III as printed.
 @dataclass(frozen=True)
 class GaitParams(_Validated):
     """Gains and thresholds of the hip servo, torso balance, knees, ankles and touchdown detection.
+
+    The defaults are the paper's walker's (drake_biped/gaits/paper.json, `--params paper`): the paper prints none
+    of them, and its walker's were searched (the gait file's `about` says how). Its hip motor is solved by the
+    controller (`motor_solve` "controller"), as its committed full run walked; the plant's solve ("plant") is
+    measured beside it (docs/RESULTS.md, "The hip motor solved in the plant's step").
 
     `swing_reading` says how eq. 2-3's zeta (the desired swing-thigh angular velocity) drives the swing:
     - "anchored": the reference angle runs from the lift-off angle phi_0 to a target,
@@ -265,11 +272,11 @@ class GaitParams(_Validated):
         "control period where the swing foot's clearance, extrapolated over the period, crosses the touchdown "
         "height (the period's torques blend the two roles' by the part of it each holds); \"update\", from the "
         "update that detects the crossing (up to one period late)")
-    hip_drive: str = param("servo", "", 'what realizes zeta at the hip (see GaitParams): "servo" or "motor"')
+    hip_drive: str = param("motor", "", 'what realizes zeta at the hip (see GaitParams): "servo" or "motor"')
     hip_joint: str = param("swing", "", 'the motor\'s joint (see GaitParams): "swing" or "inter_leg"')
-    motor_limit_nm: float = param(40.0, "N*m", "the hip motor's maximum torque (hip_drive \"motor\")", 0.0, 200.0)
+    motor_limit_nm: float = param(8.704, "N*m", "the hip motor's maximum torque (hip_drive \"motor\")", 0.0, 200.0)
     motor_solve: str = param(
-        "plant", "", 'where the hip motor\'s torque is found (hip_drive "motor"; see GaitParams): "plant", inside '
+        "controller", "", 'where the hip motor\'s torque is found (hip_drive "motor"; see GaitParams): "plant", inside '
         'the plant\'s implicit step; "controller", by the controller from a model of the plant at each update')
     motor_gain_nms: float = param(
         1000.0, "N*m*s/rad", "the hip motor's velocity gain under motor_solve \"plant\" (not printed): its torque "
@@ -289,38 +296,38 @@ class GaitParams(_Validated):
         -5.0, 5.0)
     placement_velocity_gain: float = param(
         0.1, "rad*s/m", "foot placement: and by this times the hip's forward velocity", -5.0, 5.0)
-    torso_kp: float = param(280.0, "N*m/rad", "torso: stance-hip PD to a constant pitch, gain on the pitch error",
+    torso_kp: float = param(429.7, "N*m/rad", "torso: stance-hip PD to a constant pitch, gain on the pitch error",
                             0.0, 5000.0)
-    torso_kd: float = param(28.0, "N*m*s/rad", "torso: gain on the pitch rate", 0.0, 500.0)
-    torso_pitch_rad: float = param(-0.06, "rad", "torso: the pitch held (negative leans forward)", -0.8, 0.8)
+    torso_kd: float = param(14.89, "N*m*s/rad", "torso: gain on the pitch rate", 0.0, 500.0)
+    torso_pitch_rad: float = param(-0.3469, "rad", "torso: the pitch held (negative leans forward)", -0.8, 0.8)
     # Swing knee, bang-bang: flex (below knee_flex_max_rad) until the CPG phase passes
     # knee_flex_until_phase, then passive, then extend once the phase passes knee_extend_phase and the
     # thigh is ahead by knee_extend_thigh_rad, until touchdown. Stance knee: constant extending torque.
-    knee_flex_torque: float = param(4.4, "N*m", "swing knee: the flexing torque", 0.0, 30.0)
-    knee_extend_torque: float = param(9.3, "N*m", "swing knee: the extending torque", 0.0, 30.0)
-    knee_extend_phase: float = param(1.64, "rad", "swing knee: extends once the CPG phase passes this", 0.0, math.pi)
-    knee_flex_max_rad: float = param(0.48, "rad", "swing knee: flexes while its angle is below this", 0.0, 2.4)
+    knee_flex_torque: float = param(6.894, "N*m", "swing knee: the flexing torque", 0.0, 30.0)
+    knee_extend_torque: float = param(5.743, "N*m", "swing knee: the extending torque", 0.0, 30.0)
+    knee_extend_phase: float = param(3.1, "rad", "swing knee: extends once the CPG phase passes this", 0.0, math.pi)
+    knee_flex_max_rad: float = param(0.3145, "rad", "swing knee: flexes while its angle is below this", 0.0, 2.4)
     knee_extend_thigh_rad: float = param(
-        -1.0, "rad", "swing knee: extends only once the swing thigh is this far ahead of vertical (a clearance "
+        0.05652, "rad", "swing knee: extends only once the swing thigh is this far ahead of vertical (a clearance "
         "guard: a swing slowed by the torque-free period does not put its toe into the ground mid-swing)",
         -1.0, 1.0)
     knee_flex_until_phase: float = param(
-        math.pi, "rad", "swing knee: flexing stops once the CPG phase passes this; from there until extension "
+        0.5854, "rad", "swing knee: flexing stops once the CPG phase passes this; from there until extension "
         "the knee is passive, as in ballistic walking (pi: flex until extension)", 0.0, math.pi)
     knee_hold_torque: float = param(
-        0.0, "N*m", "swing knee: its torque in that passive middle (positive flexes; 0 leaves it free)",
+        -1.772, "N*m", "swing knee: its torque in that passive middle (positive flexes; 0 leaves it free)",
         -30.0, 30.0)
-    stance_knee_torque: float = param(17.7, "N*m", "stance knee: the constant extending torque", 0.0, 30.0)
-    ankle_kp: float = param(20.0, "N*m/rad", "ankles: PD keeping each foot parallel to the local ground, gain",
+    stance_knee_torque: float = param(19.19, "N*m", "stance knee: the constant extending torque", 0.0, 30.0)
+    ankle_kp: float = param(29.78, "N*m/rad", "ankles: PD keeping each foot parallel to the local ground, gain",
                             0.0, 500.0)
-    ankle_kd: float = param(0.3, "N*m*s/rad", "ankles: rate gain", 0.0, 50.0)
+    ankle_kd: float = param(0.08836, "N*m*s/rad", "ankles: rate gain", 0.0, 50.0)
     # Touchdown (stance/swing swap) is accepted only when all of these hold.
     touchdown_min_step_s: float = param(0.15, "s", "touchdown: at least this long after the last one", 0.0, 5.0)
     touchdown_height_m: float = param(0.002, "m", "touchdown: the swing foot's clearance is below this",
                                       0.0, 0.05)
     touchdown_min_advance_m: float = param(
         0.05, "m", "touchdown: the swing ankle is at least this far ahead of the stance ankle", -0.5, 0.5)
-    touchdown_min_phase: float = param(1.0, "rad", "touchdown: the CPG phase has passed this", 0.0, math.pi)
+    touchdown_min_phase: float = param(1.555, "rad", "touchdown: the CPG phase has passed this", 0.0, math.pi)
 
     SWING_READINGS = ("anchored", "integrated")
     SWAP_TIMINGS = ("predicted", "update")
@@ -477,7 +484,7 @@ class SimulationParams(_Validated):
     under it, and it must be a whole multiple of the step. A record holds both the reading and the rate
     (`to_dict`: "controller_clock" and "update_period_s")."""
 
-    time_step_s: float = param(1e-3, "s", "the plant's time step", 1e-5, 0.02)
+    time_step_s: float = param(5e-4, "s", "the plant's time step (the paper's walker's shipped step)", 1e-5, 0.02)
     control_period_s: float | None = param(
         None, "s", "the controller's update period as a fixed-rate loop (None: the controller acts at every "
         "plant step, the paper's clock)", 1e-5, 0.05)
@@ -669,15 +676,17 @@ class RobotModel:
 
 @dataclass(frozen=True)
 class EpisodeConfig(_Validated):
-    """Everything one episode depends on."""
+    """Everything one episode depends on. `EpisodeConfig()` is the paper's walker at its shipped step
+    (drake_biped/gaits/paper.json: Table III's CPG, the paper's initiation, the hip as ODE's motor); our own faster
+    gait is `resources.load_gait("fast_servo")`."""
 
     cpg: CpgParams = field(default_factory=lambda: DEFAULT_CPG)
     gait: GaitParams = field(default_factory=lambda: DEFAULT_GAIT)
-    initial: InitialConditions = field(default_factory=InitialConditions)
+    initial: InitialConditions = field(default_factory=lambda: DEFAULT_INITIAL)
     window: TorqueFreeWindow = field(default_factory=TorqueFreeWindow)
     ground: Ground = field(default_factory=Ground)
     push: Push | None = None
-    sim: SimulationParams = field(default_factory=SimulationParams)
+    sim: SimulationParams = field(default_factory=lambda: DEFAULT_SIM)
     contact: ContactParams = field(default_factory=ContactParams)
     seed: int = param(0, "1", "recorded with the result (the episode itself is deterministic)", 0, None)
     # The robot: None for the shipped model (models/biped.urdf, Table I), else a user's model file.
@@ -843,29 +852,6 @@ def config_of_params(data: Any, where: str) -> EpisodeConfig:
     return config
 
 
-def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:
-    """The EpisodeConfig of a result record's "config": as `EpisodeConfig.from_dict`, except for three kinds of
-    record written before a choice was recorded:
-    - no "contact" section: it ran on DRAKE_DEFAULT_CONTACT, and is walked again on it;
-    - no "controller_clock" in its "sim", with the control period equal to the plant step: its walk is the same
-      under either clock, and it is read with the paper's (the controller at every plant step), so that a
-      re-walk at another step refines the controller with the plant, as today's records do. A control period
-      that differs from the step is the fixed-rate loop that record ran on, and is kept;
-    - a hip motor (gait.hip_drive "motor") and no "motor_solve": the controller solved it (the only motor there
-      was), and it is walked again so."""
-    gait = data.get("gait") if isinstance(data, Mapping) else None
-    if isinstance(gait, Mapping) and gait.get("hip_drive") == "motor" and "motor_solve" not in gait:
-        data = {**data, "gait": {**gait, "motor_solve": "controller"}}
-    config = EpisodeConfig.from_dict(data, where)
-    if isinstance(data, Mapping) and "contact" not in data:
-        config = config.replace(contact=DRAKE_DEFAULT_CONTACT)
-    sim = data.get("sim") if isinstance(data, Mapping) else None
-    if isinstance(sim, Mapping) and "controller_clock" not in sim and \
-            config.sim.control_period_s == config.sim.time_step_s:
-        config = config.replace(sim=dataclasses.replace(config.sim, control_period_s=None))
-    return config
-
-
 _SECTIONS: dict[str, type] = {
     "cpg": CpgParams,
     "gait": GaitParams,
@@ -903,26 +889,23 @@ def resolve_field(name: str) -> tuple[str, str]:
                              f"{list(_SECTIONS)}, or one of {sorted(SHORT_NAMES)}")
     return section, attr
 
-# The gait this toolkit walks by default (docs/MODEL.md, "Model and controller choices"; docs/HISTORY.md, "One gait"; docs/RESULTS.md,
-# "Physics with a continuous limit"): found by `gait-search --objective hold` (benchmarks/results/learn-hold-g1/
-# gait.json, which starts from 0.1326 rad, this from the paper's 7.6 deg). A window from t1 until touchdown saves
-# while t1 lies inside the powered step; past its end (t1 from about 0.43 s) it acts only on steps that run long.
-# The walking region is narrow: keep the values together, at full precision. The previous default is the shipped
-# gait "steady" (--params steady).
-def _shipped_default() -> tuple[CpgParams, GaitParams]:
-    """The default gait's CPG and gains, from the shipped gait file drake_biped/gaits/default.json (its `about`
-    says why it exists and where it came from)."""
+def _shipped_default() -> tuple[CpgParams, GaitParams, InitialConditions, SimulationParams, tuple[float, float]]:
+    """The default configuration's sections, from the shipped gait file drake_biped/gaits/paper.json, the paper's
+    walker (its `about` says why it exists and where it came from): its CPG (Table III), gains, initiation and
+    plant step, and the window its file declares for the commands that compare a window with none."""
     import json
     from importlib import resources
 
-    data = json.loads(resources.files("drake_biped").joinpath("gaits", "default.json").read_text())
-    where = "drake_biped/gaits/default.json"
-    return CpgParams.from_dict(data["cpg"], f"{where}, cpg"), GaitParams.from_dict(data["gait"], f"{where}, gait")
+    data = json.loads(resources.files("drake_biped").joinpath("gaits", "paper.json").read_text())
+    where = "drake_biped/gaits/paper.json"
+    window = data["compare_window"]
+    return (CpgParams.from_dict(data["cpg"], f"{where}, cpg"), GaitParams.from_dict(data["gait"], f"{where}, gait"),
+            InitialConditions.from_dict(data["initial"], f"{where}, initial"),
+            SimulationParams.from_dict(data["sim"], f"{where}, sim"), (window["start_s"], window["end_s"]))
 
 
-DEFAULT_CPG, DEFAULT_GAIT = _shipped_default()
-# The default gait's learned torque-free window (t1, t2) in s: the committed full run's best trial of Experiment 1
-# (benchmarks/results/reproduce-full/learn/, trial 1), rounded to 0.1 ms as the reproduction rounds it. The one
-# default of every command that compares a window with none (stability, push-margin, basins, slope,
-# time-step-study) where no --t1/--t2 or --policy is given and the gait carries no window of its own.
-LEARNED_WINDOW_S = (0.3672, 0.8629)
+# The default configuration's sections: the paper's walker's. DEFAULT_WINDOW_S is the window (t1, t2) in s its gait
+# file declares (`compare_window`): what every command that compares a window with none (stability, push-margin,
+# basins, slope, time-step-study) takes on it where no --t1/--t2 or --policy is given. Another gait's is its own
+# file's, or given (resources.gait_compare_window).
+DEFAULT_CPG, DEFAULT_GAIT, DEFAULT_INITIAL, DEFAULT_SIM, DEFAULT_WINDOW_S = _shipped_default()

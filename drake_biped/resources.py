@@ -8,13 +8,15 @@ Drake's PackageMap.
 
 from __future__ import annotations
 
+import functools
 import os
 from importlib import resources
 from pathlib import Path
 
-from drake_biped.params import EpisodeConfig, ParameterError, config_of_params, config_of_record
+from drake_biped.legacy import config_of_record
+from drake_biped.params import EpisodeConfig, ParameterError, config_of_params
 
-__all__ = ["full_run_digest", "gait_about", "gait_compare_window", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
+__all__ = ["full_run_digest", "gait_about", "gait_compare_window", "gait_identity", "gait_names", "gait_path", "grid_spec_names", "grid_spec_path", "load_gait", "model_package_xml",
            "shipped_model_file"]
 
 
@@ -98,6 +100,37 @@ def gait_compare_window(value: str | Path) -> tuple[tuple[float, float], str] | 
 def gait_path(value: str | Path) -> Path:
     """A shipped gait by name (`climbing`, `climbing_2deg`, ...) or a parameter file by path."""
     return _named_or_path(value, "gaits", ".json", gait_names(), "--params")
+
+
+def walker_digest(config: EpisodeConfig) -> str:
+    """The SHA-256 of what makes a walker: its CPG, its gains as the controller reads them (`GaitParams.as_walked`:
+    a gain its readings leave unread is no difference) and its initiation, as canonical JSON. The window, the
+    ground, the plant step and the episode's limits are not the walker's."""
+    import hashlib
+    import json
+
+    walker = {"cpg": config.cpg.to_dict(), "gait": config.gait.as_walked().to_dict(), "initial": config.initial.to_dict()}
+    return hashlib.sha256(json.dumps(walker, sort_keys=True).encode()).hexdigest()
+
+
+@functools.lru_cache(maxsize=1)
+def _shipped_digests(names: tuple[str, ...]) -> dict[str, str]:
+    return {walker_digest(load_gait(name)): name for name in names}
+
+
+def gait_identity(config: EpisodeConfig) -> dict[str, str | None]:
+    """Which gait walks `config`: {"name": the shipped gait (`--params NAME`) whose CPG, gains and initiation it
+    walks, or None for another gait; "sha256": `walker_digest(config)`}. A shipped gait walked at another plant
+    step, with a window or pushed is still that gait."""
+    digest = walker_digest(config)
+    return {"name": _shipped_digests(tuple(gait_names())).get(digest), "sha256": digest}
+
+
+def gait_text(identity: dict[str, str | None] | None) -> str:
+    """A gait's identity in words: "paper (sha256 1a2b3c4d5e6f)", "another gait (sha256 ...)"."""
+    if not identity:
+        return "a gait not recorded"
+    return f"{identity.get('name') or 'another gait'} (sha256 {str(identity.get('sha256'))[:12]})"
 
 
 def grid_spec_path(value: str | Path) -> Path:

@@ -1,7 +1,8 @@
 import pytest
+from walkers import fast_config
 
 from drake_biped.episode import run_episode
-from drake_biped.params import EpisodeConfig, SimulationParams
+from drake_biped.params import SimulationParams
 
 
 @pytest.fixture(scope="session")
@@ -16,5 +17,5 @@ def client():
 @pytest.fixture(scope="session")
 def short_walk():
     """A 3 m walk of the default gait, recorded once for several tests."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=15.0))
+    config = fast_config(sim=SimulationParams(distance_m=3.0, max_time_s=15.0))
     return run_episode(config, record_trajectory=True)

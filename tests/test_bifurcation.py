@@ -5,11 +5,12 @@ import json
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.common.walks import attractor_of_walk
 from drake_biped.episode import run_episode
 from drake_biped.experiments import bifurcation
-from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.params import ParameterError
 from tests.test_failures import one_line, run_cli
 
 
@@ -36,7 +37,7 @@ def test_the_transient_is_dropped_and_the_rest_labelled():
 
 
 def test_points_are_the_api_walks_and_a_rerun_resumes(tmp_path, client):
-    config = EpisodeConfig().override({"sim.distance_m": 9.0, "sim.max_time_s": 40.0, "window.end_s": 0.944})
+    config = fast_config().override({"sim.distance_m": 9.0, "sim.max_time_s": 40.0, "window.end_s": 0.944})
     settings = bifurcation.BifurcationSettings(config, "t1", (0.46,), transient_m=3.0, lyapunov=False)
     record = bifurcation.run(settings, tmp_path, client, progress=False)
     (point,) = record["points"]
@@ -72,7 +73,7 @@ def test_bad_parameters_are_one_line(capsys, tmp_path):
 def test_basins_walk_each_start_with_and_without_the_window(tmp_path, client):
     from drake_biped.experiments import basins
 
-    config = EpisodeConfig().override({"sim.distance_m": 6.0, "sim.max_time_s": 30.0})
+    config = fast_config().override({"sim.distance_m": 6.0, "sim.max_time_s": 30.0})
     settings = basins.BasinSettings(config, (0.405, 0.944), (0.12, 0.14), (0.19,), transient_m=2.0)
     start = basins.start_config(settings, "with", 0.14, 0.19)
     assert (start.initial.hip_angle_rad, start.initial.speed_mps) == (0.14, 0.19)
@@ -115,13 +116,13 @@ def test_options_that_would_change_nothing_are_refused_naming_them(capsys, tmp_p
 def test_an_unread_gain_is_refused_for_being_unread_not_for_the_window():
     """The default gait carries no window: the old message blamed t2 <= t1 for any parameter that changed nothing."""
     with pytest.raises(ParameterError) as refused:
-        bifurcation.BifurcationSettings(param="gait.motor_limit_nm", values=(20.0, 30.0))
-    assert "unread under this gait's hip drive 'servo'" in str(refused.value)
+        bifurcation.BifurcationSettings(param="gait.hip_kd", values=(20.0, 30.0))
+    assert "unread under this gait's hip drive 'motor'" in str(refused.value)
     assert "t2 <= t1" not in str(refused.value)
 
 
 def test_a_slope_sweep_whose_walks_end_on_the_level_is_refused():
-    config = EpisodeConfig().override({"sim.distance_m": 12.0, "sim.max_time_s": 80.0,
+    config = fast_config().override({"sim.distance_m": 12.0, "sim.max_time_s": 80.0,
                                        "ground.slope_rad": 0.01, "ground.level_length_m": 20.0})
     with pytest.raises(ParameterError, match="--distance 12 --level-length 20"):
         bifurcation.BifurcationSettings(config, "slope", (0.01, 0.02), transient_m=3.0)

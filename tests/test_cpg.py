@@ -5,12 +5,13 @@ import math
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
+from walkers import fast_config
 
 from drake_biped import controller as ctl
 from drake_biped import cpg
 from drake_biped.diagram import initial_state
 from drake_biped.model import joint_index
-from drake_biped.params import CpgParams, EpisodeConfig, TorqueFreeWindow
+from drake_biped.params import CpgParams, TorqueFreeWindow
 
 
 def test_output_is_equation_three_with_alpha_and_eta():
@@ -54,8 +55,8 @@ def test_window_edges_between_updates_scale_the_torque_by_the_part_outside():
     without a window) times the part of the period outside the window; whole periods are 0 or unscaled."""
     window = TorqueFreeWindow(0.0503, 0.1203, first_step=0)
     dt, h = 1e-3, 1e-3
-    c_w, sim_w, ctx_w = _controller_alone(EpisodeConfig(window=window))
-    c_0, sim_0, ctx_0 = _controller_alone(EpisodeConfig())
+    c_w, sim_w, ctx_w = _controller_alone(fast_config(window=window))
+    c_0, sim_0, ctx_0 = _controller_alone(fast_config())
     swing_hip = joint_index("left", "hip")
     seen = set()
     for k in range(1, 150):
@@ -89,7 +90,7 @@ def _controller_alone(config):
 
 
 def test_phase_matches_closed_form_when_kappa_is_zero():
-    config = EpisodeConfig(cpg=CpgParams(u_a=2.0, u_r=2.1, kappa=0.0))
+    config = fast_config(cpg=CpgParams(u_a=2.0, u_r=2.1, kappa=0.0))
     c, sim, ctx = _controller_alone(config)
     for t in (0.1, 0.5, 1.0, 1.4):
         sim.AdvanceTo(t)
@@ -101,7 +102,7 @@ def test_phase_matches_closed_form_when_kappa_is_zero():
 
 
 def test_kappa_feeds_stance_ankle_rate_into_phase():
-    config = EpisodeConfig(cpg=CpgParams(u_a=2.0, u_r=2.0, kappa=1.5))
+    config = fast_config(cpg=CpgParams(u_a=2.0, u_r=2.0, kappa=1.5))
     c, sim, ctx = _controller_alone(config)
     q, v, _, _ = initial_state(config)
     x = c.get_input_port_plant_state().Eval(ctx).copy()
@@ -113,7 +114,7 @@ def test_kappa_feeds_stance_ankle_rate_into_phase():
 
 def test_gate_zeroes_swing_hip_and_freezes_integrator():
     window = TorqueFreeWindow(0.05, 0.12, first_step=0)
-    config = EpisodeConfig(window=window)
+    config = fast_config(window=window)
     config = config.replace(gait=config.gait.__class__(**{**config.gait.to_dict(), "hip_ki": 50.0}))
     c, sim, ctx = _controller_alone(config)
     swing_hip = joint_index("left", "hip")  # the left leg is the first swing leg
@@ -148,9 +149,10 @@ def test_integrated_reading_drives_the_swing_by_zeta_unscaled():
     of the controller on a fixed plant state (the thigh at rest)."""
     from drake_biped.params import PAPER_CPG, GaitParams
 
-    gait = GaitParams(swing_reading="integrated", placement_gain=0.0, placement_velocity_gain=0.0,
-                      swing_offset_rad=0.0, hip_kp=80.0, hip_kd=9.0, hip_ki=0.0)
-    config = EpisodeConfig(cpg=PAPER_CPG.__class__(**{**PAPER_CPG.to_dict(), "kappa": 0.0}), gait=gait)
+    gait = GaitParams(hip_drive="servo", swing_reading="integrated", placement_gain=0.0, placement_velocity_gain=0.0,
+                      swing_offset_rad=0.0, hip_kp=80.0, hip_kd=9.0, hip_ki=0.0,
+                      torso_pitch_rad=-0.06)  # a torso near upright: the servo starts below its limit
+    config = fast_config(cpg=PAPER_CPG.__class__(**{**PAPER_CPG.to_dict(), "kappa": 0.0}), gait=gait)
     c, sim, ctx = _controller_alone(config)
     x = c.get_input_port_plant_state().Eval(ctx)
     q = x[:9]
@@ -183,7 +185,7 @@ def test_the_phase_reading_decides_what_swaps_the_legs(gait, reading):
     from drake_biped.episode import run_episode
     from drake_biped.resources import load_gait
 
-    config = (EpisodeConfig() if gait is None else load_gait(gait)).override({"sim.distance_m": 3.0})
+    config = (fast_config() if gait is None else load_gait(gait)).override({"sim.distance_m": 3.0})
     if gait == "paper_entrained":  # it falls in its first step at 1 ms, and at 0.5 ms under the paper's clock;
         # it walks at 0.5 ms under a 1 kHz loop: the reading is what is tested
         config = config.override({"sim.time_step_s": 5e-4, "sim.control_period_s": 1e-3})

@@ -5,6 +5,7 @@ import re
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.analysis.cost_of_transport import positive_work
 from drake_biped.diagram import TorsoPush, build_diagram
@@ -68,7 +69,7 @@ def test_work_energy_theorem(short_walk):
 
 
 def test_window_gives_zero_swing_hip_torque_whenever_gated():
-    config = EpisodeConfig(window=TorqueFreeWindow(0.1, 0.3), sim=SimulationParams(distance_m=1.0, max_time_s=5.0))
+    config = fast_config(window=TorqueFreeWindow(0.1, 0.3), sim=SimulationParams(distance_m=1.0, max_time_s=5.0))
     r = run_episode(config, record_trajectory=True)
     T = r.trajectory
     gated = T["torque_free"] == 1.0  # periods wholly inside the window (an edge period is scaled)
@@ -93,7 +94,7 @@ def test_result_record_round_trips(short_walk, tmp_path):
 
 
 def test_same_config_same_numbers():
-    config = EpisodeConfig(sim=SimulationParams(distance_m=0.5, max_time_s=3.0), seed=7)
+    config = fast_config(sim=SimulationParams(distance_m=0.5, max_time_s=3.0), seed=7)
     a, b = run_episode(config), run_episode(config)
     assert a.positive_work_j == b.positive_work_j and a.distance_m == b.distance_m
 
@@ -110,8 +111,8 @@ def test_push_delivers_its_impulse():
 
 def test_push_is_wired_only_when_requested():
     names = lambda c: [s.get_name() for s in build_diagram(c).diagram.GetSystems()]  # noqa: E731
-    assert "torso_push" not in names(EpisodeConfig())
-    assert "torso_push" in names(EpisodeConfig(push=Push(20.0, 0.4, 0.1)))
+    assert "torso_push" not in names(fast_config())
+    assert "torso_push" in names(fast_config(push=Push(20.0, 0.4, 0.1)))
 
 
 def test_a_torque_free_window_saves_the_hips_work_on_a_short_walk():
@@ -119,8 +120,8 @@ def test_a_torque_free_window_saves_the_hips_work_on_a_short_walk():
     freed from 0.2 s until the foot lands does less positive work per metre (measured -25 %) and the walk
     costs less (-27 %)."""
     sim = SimulationParams(distance_m=2.0, max_time_s=10.0)
-    base = run_episode(EpisodeConfig(sim=sim))
-    gated = run_episode(EpisodeConfig(sim=sim, window=TorqueFreeWindow(0.2, 1.2)))
+    base = run_episode(fast_config(sim=sim))
+    gated = run_episode(fast_config(sim=sim, window=TorqueFreeWindow(0.2, 1.2)))
     assert not base.fell and not gated.fell
     hips = lambda r: r.positive_work_j["left_hip"] + r.positive_work_j["right_hip"]  # noqa: E731
     assert hips(gated) / gated.distance_m < 0.8 * hips(base) / base.distance_m
@@ -135,8 +136,8 @@ def test_torque_free_window_saves_energy_without_a_fall():
     hips = lambda r: r.positive_work_j["left_hip"] + r.positive_work_j["right_hip"]  # noqa: E731
     for step in (1e-3, 5e-4):
         sim = SimulationParams(time_step_s=step)
-        base = run_episode(EpisodeConfig(sim=sim))
-        gated = run_episode(EpisodeConfig(sim=sim, window=TorqueFreeWindow(0.3, 1.2)))
+        base = run_episode(fast_config(sim=sim))
+        gated = run_episode(fast_config(sim=sim, window=TorqueFreeWindow(0.3, 1.2)))
         assert not base.fell and not gated.fell and gated.distance_m >= 10.0
         assert gated.cost_of_transport < 0.65 * base.cost_of_transport
         assert hips(gated) / gated.distance_m < 0.65 * hips(base) / base.distance_m
@@ -152,7 +153,7 @@ def test_push_changes_the_airborne_robot_momentum_by_exactly_its_impulse():
 
     from drake_biped.diagram import initial_state
 
-    config = EpisodeConfig(push=Push(force_n=20.0, start_s=0.4, duration_s=0.1),
+    config = fast_config(push=Push(force_n=20.0, start_s=0.4, duration_s=0.1),
                            sim=SimulationParams(max_time_s=1.0))
     parts = build_diagram(config)
     sim = Simulator(parts.diagram)
@@ -179,7 +180,7 @@ def test_push_changes_the_airborne_robot_momentum_by_exactly_its_impulse():
 def test_a_kick_changes_the_swing_hip_and_nothing_else_changes_without_one():
     from drake_biped.episode import Kick
 
-    config = EpisodeConfig(sim=SimulationParams(distance_m=2.0, max_time_s=8.0))
+    config = fast_config(sim=SimulationParams(distance_m=2.0, max_time_s=8.0))
     plain = run_episode(config)
     assert run_episode(config, kick=Kick(time_s=100.0)).steps == plain.steps  # after the end: no kick
     kicked = run_episode(config, kick=Kick(time_s=1.0, hip_rate_radps=0.3))
@@ -195,7 +196,7 @@ def test_a_kick_changes_the_swing_hip_and_nothing_else_changes_without_one():
 def test_the_first_swing_starts_from_the_initial_cpg_phase():
     """InitialConditions.cpg_phase_rad seeds gamma: the first update advances it from there (eq. 2)."""
 
-    config = EpisodeConfig(initial=InitialConditions(cpg_phase_rad=1.2),
+    config = fast_config(initial=InitialConditions(cpg_phase_rad=1.2),
                            sim=SimulationParams(distance_m=0.05, max_time_s=0.0105))
     parts, simulator, _, _ = simulate(config, cache=None)
     s = parts.controller.state(parts.controller.GetMyContextFromRoot(simulator.get_context()))
@@ -211,12 +212,12 @@ def test_a_diverging_control_loop_is_named_diverged_not_a_fall():
     while the walk at 1 ms has none."""
     from drake_biped import control_kernel as ctl
 
-    coarse = run_episode(EpisodeConfig().override({"sim.time_step_s": 0.01, "sim.control_period_s": 0.01,
+    coarse = run_episode(fast_config().override({"sim.time_step_s": 0.01, "sim.control_period_s": 0.01,
                                                    "sim.distance_m": 1.0}))
     assert coarse.termination == "diverged" and coarse.fell
     reversals = re.match(r"the control loop diverged: (\d+) torque reversals", coarse.fall_reason)
     assert reversals and 5 <= int(reversals.group(1)) <= 8  # the fifth ends it; one update may add a few
     assert coarse.duration_s < 0.2  # caught within a few periods, not after a second of chattering
-    parts, simulator, reason, _ = simulate(EpisodeConfig(sim=SimulationParams(distance_m=2.0, max_time_s=8.0)))
+    parts, simulator, reason, _ = simulate(fast_config(sim=SimulationParams(distance_m=2.0, max_time_s=8.0)))
     state = parts.controller.state(parts.controller.GetMyContextFromRoot(simulator.get_context()))
     assert reason == "distance" and state.torque_reversals == 0.0 and ctl.DIVERGED_REVERSALS == 5

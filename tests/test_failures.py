@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 from drake_biped.cli import main
-from drake_biped.params import ParameterError
+from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.resources import gait_identity
 
 
 def run_cli(capsys, argv):
@@ -121,8 +122,8 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
     # options that change nothing
     (["bifurcation", "--param", "t1", "--from", "0.2", "--to", "0.3", "--num", "2", "--out", "{tmp}/b"],
      ["--param t1 --from 0.2 --to 0.3", "never opens", "--t2"]),
-    (["bifurcation", "--param", "u_a", "--from", "2", "--to", "2.5", "--num", "2", "--second-time-step", "0.001",
-      "--out", "{tmp}/b"], ["--second-time-step 0.001", "same result"]),
+    (["bifurcation", "--param", "u_a", "--from", "2", "--to", "2.5", "--num", "2", "--second-time-step", "0.0005",
+      "--out", "{tmp}/b"], ["--second-time-step 0.0005", "same result"]),
     (["grid", "--spec", "{file:spec_noop.yaml}", "--out", "{tmp}/g"], ["axis window.start_s", "changes nothing"]),
     (["walk", "--level-length", "2", "--out", "{tmp}/w"], ["--level-length 2", "changes nothing"]),
     (["walk", "--push", "0", "--out", "{tmp}/w"], ["--push 0", "changes nothing"]),
@@ -615,7 +616,8 @@ def test_a_short_walk_says_it_has_too_few_touchdowns_for_a_step_period(tmp_path,
     # It printed "step n/a / n/a". A 0.3 m walk ends before its first touchdown.
     assert main(["walk", "--distance", "0.3", "--no-animation", "--out", str(tmp_path / "w")]) == 0
     out, err = capsys.readouterr()
-    first = out.splitlines()[0]
+    assert out.splitlines()[0].startswith("gait: paper (sha256 ")
+    first = out.splitlines()[1]
     assert first.startswith("ended: distance: 0.30 m") and "n/a" not in first
     assert first.endswith("0 steps, too few for a step period and length (3 touchdowns needed)")
     assert "animation:" not in out and "Traceback" not in err
@@ -774,9 +776,12 @@ def test_a_time_step_above_the_converged_range_warns_and_a_diverging_walk_says_s
     err = capsys.readouterr()
     assert code == 0
     assert [line for line in err.err.splitlines() if line.startswith("warning:")] == [
-        "warning: --time-step 0.01 is above 1 ms, beyond the steps at which the default gait's walk converges "
-        "(docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its control loop diverges, which ends an episode as 'diverged'"]
-    assert err.out.startswith("DIVERGED (the control loop diverged")
+        "warning: --time-step 0.01 is above 1 ms, coarser than any shipped gait's step and than the steps at which "
+        "their walks converge (docs/RESULTS.md, 'Physics with a continuous limit', 'Its plant step, refined past "
+        "0.25 ms'); from 5 ms the control loop diverges, which ends an episode as 'diverged'"]
+    assert err.out.splitlines()[0] == "gait: paper (sha256 " + gait_identity(EpisodeConfig())["sha256"][:12] + \
+        "), plant step 10 ms"
+    assert err.out.splitlines()[1].startswith("DIVERGED (the control loop diverged")
     record = json.loads((tmp_path / "w" / "result.json").read_text())
     assert record["termination"] == "diverged" and record["fell"]
 

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 from retired_gaits import STEADY
+from walkers import fast_config
 
 from drake_biped.analysis import floquet as fq
 
@@ -239,10 +240,9 @@ def test_the_rimless_wheel_multiplier_is_cos_squared_two_alpha():
 # --- the biped's step map through Drake ----------------------------------------------------------------
 @pytest.fixture(scope="module")
 def biped_map():
-    from drake_biped.params import EpisodeConfig
     from drake_biped.step_map import SectionMap
 
-    section_map = SectionMap(EpisodeConfig())
+    section_map = SectionMap(fast_config())
     z0, template = section_map.start(6)
     return section_map, z0, template
 

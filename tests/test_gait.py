@@ -1,14 +1,17 @@
 """The leg laws: knee bang-bang with its clearance guard, touchdown, torso and ankle signs."""
 
 import dataclasses
+import math
 
 import pytest
 
 from drake_biped import gait
 from drake_biped.params import GaitParams
 
+# The knee law's every field given (the defaults are the paper's walker's): flexing until extension, no hold torque.
+KNEE = dict(knee_flex_until_phase=math.pi, knee_hold_torque=0.0)
 G = GaitParams(knee_flex_torque=5.0, knee_extend_torque=7.0, knee_extend_phase=2.0, knee_flex_max_rad=0.6,
-               knee_extend_thigh_rad=0.2)
+               knee_extend_thigh_rad=0.2, **KNEE)
 
 
 @pytest.mark.parametrize("gamma, knee, thigh, expected", [
@@ -23,7 +26,7 @@ def test_swing_knee(gamma, knee, thigh, expected):
 
 def test_swing_knee_passive_middle():
     g = GaitParams(knee_flex_torque=5.0, knee_extend_torque=7.0, knee_extend_phase=2.5, knee_flex_max_rad=1.2,
-                   knee_extend_thigh_rad=0.2, knee_flex_until_phase=1.0)
+                   knee_extend_thigh_rad=0.2, knee_flex_until_phase=1.0, knee_hold_torque=0.0)
     assert gait.swing_knee_torque(g, 0.5, 0.3, -0.3) == 5.0  # flexion burst
     assert gait.swing_knee_torque(g, 1.5, 0.8, -0.1) == 0.0  # passive
     assert gait.swing_knee_torque(g, 1.5, 1.3, -0.1) == -7.0  # limit guard
@@ -35,7 +38,7 @@ def test_swing_knee_passive_middle():
 
 def test_swing_knee_switch_inside_a_period_blends_by_the_time_each_branch_holds():
     g = GaitParams(knee_flex_torque=5.0, knee_extend_torque=7.0, knee_extend_phase=2.5, knee_flex_max_rad=1.2,
-                   knee_extend_thigh_rad=0.2, knee_flex_until_phase=1.0)
+                   knee_extend_thigh_rad=0.2, knee_flex_until_phase=1.0, knee_hold_torque=0.0)
     # the phase crosses knee_flex_until_phase a quarter of the way through: flex for 1/4, passive for 3/4
     assert gait.swing_knee_torque_over(g, (0.9, 0.5, -0.2), (1.3, 0.5, -0.2)) == pytest.approx(1.25, abs=1e-5)
     # the thigh reaches knee_extend_thigh_rad at 60 % of the period (phase already past 2.5): passive, then extend

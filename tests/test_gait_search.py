@@ -7,6 +7,7 @@ import random
 import numpy as np
 import pytest
 from retired_gaits import STEADY
+from walkers import fast_config
 
 from drake_biped.experiments import gait_search, objectives
 from drake_biped.experiments.gait_search import (
@@ -22,7 +23,7 @@ from drake_biped.params import PAPER_CPG, EpisodeConfig, ParameterError, Simulat
 
 
 def test_mutation_changes_every_listed_parameter_within_bounds():
-    c = EpisodeConfig()
+    c = fast_config()
     child = mutate(c, random.Random(1), sigma=0.5)
     for (section, name), (_, _, lo, hi) in MUTATIONS.items():
         before, after = getattr(getattr(c, section), name), getattr(getattr(child, section), name)
@@ -32,7 +33,7 @@ def test_mutation_changes_every_listed_parameter_within_bounds():
 
 
 def test_search_keeps_the_best_parent_and_resumes(tmp_path, client, capsys):
-    start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
+    start = fast_config(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
     kwargs = dict(offspring=2, sigma=0.3, seed=4, distance_m=0.3, windows=((0.1, 0.2),))
     run(GaitSearchSettings(start, generations=2, **kwargs), tmp_path, client, progress=False)
     records = _read_log(tmp_path / "search.jsonl")
@@ -98,7 +99,7 @@ def test_a_walker_outscores_any_fall_and_a_longer_fall_a_shorter(monkeypatch):
                 "reward": min(d / config.sim.distance_m, 1.0) / 0.2}
 
     monkeypatch.setattr(objectives, "_walk", fake_walk)
-    config = EpisodeConfig(sim=SimulationParams(distance_m=6.0))
+    config = fast_config(sim=SimulationParams(distance_m=6.0))
     scores = []
     for d in (0.5, 3.0, 6.0):
         walks[0.0, 0.0] = d
@@ -115,7 +116,7 @@ def test_policy_objective_is_the_expected_gain_of_the_draws(monkeypatch):
         return {"walked": True, "cost_of_transport": cmt, "distance_m": 6.0, "reward": 1.0 / cmt}
 
     monkeypatch.setattr(objectives, "_walk", fake_walk)
-    value, detail = objectives.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="policy")
+    value, detail = objectives.score(fast_config(sim=SimulationParams(distance_m=6.0)), objective="policy")
     draws = policy_draws()
     windowed = sum(1 for t1, t2 in draws if t2 > t1)
     assert 0 < windowed < len(draws)
@@ -123,11 +124,11 @@ def test_policy_objective_is_the_expected_gain_of_the_draws(monkeypatch):
     assert [r["window"] for r in detail["windows"]] == [list(d) for d in draws]
     more = policy_draws(32)
     assert more[:len(draws)] == draws  # more draws extend the same fixed sequence
-    value, detail = objectives.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="policy",
+    value, detail = objectives.score(fast_config(sim=SimulationParams(distance_m=6.0)), objective="policy",
                                       draws=32)
     assert [r["window"] for r in detail["windows"]] == [list(d) for d in more]
     assert value == pytest.approx(sum(1 for t1, t2 in more if t2 > t1) / 32 + 0.5)
-    value, _ = objectives.score(EpisodeConfig(sim=SimulationParams(distance_m=6.0)), objective="expected", draws=32)
+    value, _ = objectives.score(fast_config(sim=SimulationParams(distance_m=6.0)), objective="expected", draws=32)
     assert value == pytest.approx(sum(1 for t1, t2 in more if t2 > t1) / 32)  # the mean gain alone
 
 
@@ -142,7 +143,7 @@ def test_unknown_search_settings_are_refused():
 
 @pytest.mark.slow
 def test_cmaes_search_resumes_to_the_uninterrupted_result(tmp_path, client):
-    start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
+    start = fast_config(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
     kwargs = dict(offspring=4, sigma=0.3, seed=2, distance_m=0.3, windows=((0.1, 0.2),))
     whole, parts = tmp_path / "whole", tmp_path / "parts"
     gait_search.run_cmaes(GaitSearchSettings(start, generations=3, **kwargs), whole, client, progress=False)
@@ -160,7 +161,7 @@ def test_cmaes_search_resumes_to_the_uninterrupted_result(tmp_path, client):
 
 
 def test_decode_maps_zero_to_the_start_and_stays_in_bounds():
-    start = EpisodeConfig(cpg=PAPER_CPG)
+    start = fast_config(cpg=PAPER_CPG)
     assert gait_search.decode(start, PAPER_MUTATIONS, [0.0] * len(PAPER_MUTATIONS)).gait == start.gait
     far = gait_search.decode(start, PAPER_MUTATIONS, [1000.0] * len(PAPER_MUTATIONS))
     for (section, name), (_, _, _, hi) in PAPER_MUTATIONS.items():
@@ -171,9 +172,9 @@ def test_decode_maps_zero_to_the_start_and_stays_in_bounds():
 def test_nearest_objective_prefers_the_walker_nearest_table_iii(monkeypatch):
     monkeypatch.setattr(objectives, "_walk", lambda config: {"walked": True, "cost_of_transport": 0.2,
                                                               "distance_m": 6.0, "reward": 5.0})
-    near = EpisodeConfig(cpg=PAPER_CPG.__class__(u_a=2.2, u_r=2.1, kappa=1.8))
-    far = EpisodeConfig()  # the default gait's CPG: u_r 4.6
-    assert objectives.score(EpisodeConfig(cpg=PAPER_CPG), objective="nearest")[0] == 0.0
+    near = fast_config(cpg=PAPER_CPG.__class__(u_a=2.2, u_r=2.1, kappa=1.8))
+    far = fast_config()  # the default gait's CPG: u_r 4.6
+    assert objectives.score(fast_config(cpg=PAPER_CPG), objective="nearest")[0] == 0.0
     d = math.log(1.1)
     assert objectives.score(near, objective="nearest")[0] == pytest.approx(-d / (1 + d) / 3)
     assert objectives.score(far, objective="nearest")[0] < objectives.score(near, objective="nearest")[0]
@@ -190,8 +191,8 @@ def test_nearest_objective_ranks_a_walker_that_survives_the_pushes_first(monkeyp
                     "reward": 5.0}
         return walk
 
-    exact = EpisodeConfig(cpg=PAPER_CPG).override({"sim.distance_m": 6.0})
-    far = EpisodeConfig().override({"sim.distance_m": 6.0, "u_r": 30.0, "u_a": 0.05})
+    exact = fast_config(cpg=PAPER_CPG).override({"sim.distance_m": 6.0})
+    far = fast_config().override({"sim.distance_m": 6.0, "u_r": 30.0, "u_a": 0.05})
     monkeypatch.setattr(objectives, "_walk", fake(walks_pushed=False))
     lucky, detail = objectives.score(exact, objective="nearest")
     assert [p["push_n"] for p in detail["pushes"]] == [objectives.PUSH_FORCE_N, -objectives.PUSH_FORCE_N]
@@ -225,7 +226,7 @@ def _fake_story_walk(half_step_cmt=0.2, fall_at_fast_start=False):
 def test_robust_objective_counts_the_distance_walked_and_the_half_steps_cmt_change(monkeypatch):
     """All checks walk: 0, less 1/6 when the half step changes C_mt by 5 % (capped excess 1); a check that
     falls at a quarter of the distance takes (1/4 - 1)/6 from the mean fraction walked."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
+    config = fast_config(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
     monkeypatch.setattr(objectives, "_walk", _fake_story_walk())
     assert objectives.score(config, objective="robust")[0] == 0.0
     monkeypatch.setattr(objectives, "_walk", _fake_story_walk(half_step_cmt=0.21))
@@ -239,7 +240,7 @@ def test_robust_objective_counts_the_distance_walked_and_the_half_steps_cmt_chan
 def test_story_objective_judges_each_draw_where_it_saves_least(monkeypatch):
     """The robust checks hold: each drawn window's gain is its gain at half the step (1/3, not 1), and the best
     draw's is its gain from 0.95 x the initiation speed (1/9); a gait that fails a robust check scores below -2."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
+    config = fast_config(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
     monkeypatch.setattr(objectives, "_walk", _fake_story_walk())
     value, detail = objectives.score(config, objective="story")
     windowed = sum(1 for t1, t2 in policy_draws() if t2 > t1)
@@ -281,7 +282,7 @@ def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatc
     """The learner's reach is the windows within 0.05 of the best reward gain in any of the four walks, those with
     t1 in 0.36-0.48 s, and those 0.02 s from either; the score is the smallest saving there, in any walk, plus a
     tenth of the mean smallest gain."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
+    config = fast_config(sim=SimulationParams(distance_m=10.0, time_step_s=0.001))
     walk, saving = _fake_edge_walk(edge, half, edge_t1, fall_off)
     monkeypatch.setattr(objectives, "_walk", walk)
     value, detail = objectives.score(config, objective="hold")
@@ -296,7 +297,7 @@ def test_hold_objective_judges_every_window_within_the_learners_reach(monkeypatc
 @pytest.mark.parametrize("method", ["es", "cmaes"])
 def test_a_search_stops_once_the_objective_maximum_is_reached(tmp_path, client, method):
     # "walk" scores every walker 0, its maximum: a start that walks leaves nothing to search for.
-    start = EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
+    start = fast_config(sim=SimulationParams(distance_m=0.3, max_time_s=3.0))
     settings = GaitSearchSettings(start, generations=5, offspring=4, sigma=0.3, seed=2, distance_m=0.3,
                                   objective="walk")
     search = gait_search.run_cmaes if method == "cmaes" else run
@@ -320,7 +321,10 @@ def test_a_search_over_gains_its_gait_leaves_unread_is_refused_naming_them_and_t
                                              r"'reset'\).*\['paper_motor'\]"):
         GaitSearchSettings(config=load_gait("paper"), mutations="paper")
     with pytest.raises(ParameterError, match="'paper_motor' move motor_limit_nm"):
-        GaitSearchSettings(mutations="paper_motor")
+        GaitSearchSettings(config=load_gait("fast_servo"), mutations="paper_motor")
+    # unless told, the set that fits the gait's hip drive
+    assert GaitSearchSettings().mutations == "paper_motor"
+    assert GaitSearchSettings(config=load_gait("fast_servo")).mutations == "servo"
     GaitSearchSettings(config=load_gait("paper"), mutations="paper_motor")  # every gain it moves is read
     # the entrained phase leaves the touchdown threshold unread, which every set moves: it cannot be avoided, so
     # the readings searched from entrained starts still run (benchmarks/results/paper-walker/start-*-entrained)
@@ -352,7 +356,7 @@ def test_converged_objective_scores_the_spread_and_the_chatter_at_the_walks_own_
             "time": t, "actuation": act, "stance_right": np.ones(len(t)),
             "actuator_names": np.array([f"{leg}_{j}_motor" for leg in ("left", "right") for j in ("hip", "knee", "ankle")])})
 
-    config = EpisodeConfig(sim=SimulationParams(distance_m=100.0))
+    config = fast_config(sim=SimulationParams(distance_m=100.0))
     for robust, spread, changes, moved, expected in ((0.0, 5e-4, 10.0, 0.002, 0.0),
                                                      (0.0, 2e-3, 30.0, -0.0075, -2.0 / 3.0),
                                                      (-0.3, 5e-4, 10.0, 0.002, -2.3)):

@@ -6,6 +6,7 @@ applied."""
 
 import numpy as np
 import pytest
+from walkers import FAST
 
 import drake_biped.control_kernel as ctl
 from drake_biped.cpg import output
@@ -19,7 +20,9 @@ READINGS = [("swing", "plant"), ("swing", "controller"), ("inter_leg", "controll
 
 
 def _motor(joint: str, solve: str = "plant", **changes) -> EpisodeConfig:
-    return EpisodeConfig().override({"gait.hip_drive": "motor", "gait.hip_joint": joint, "gait.motor_solve": solve,
+    """Our own fast gait (`fast_servo`, 0.43 s steps at 1 ms) driven by the motor: quick walks that reach its
+    limit, its window and the knees' stops."""
+    return FAST.override({"gait.hip_drive": "motor", "gait.hip_joint": joint, "gait.motor_solve": solve,
                                      "sim.distance_m": 10.0, **changes})
 
 
@@ -168,7 +171,7 @@ def test_the_fields_a_reading_leaves_unread_change_no_walk_and_a_grid_refuses_th
     paper = load_gait("paper").override({"gait.motor_solve": "plant", "sim.distance_m": 10.0, "sim.max_time_s": 2.0})
     assert set(paper.gait.unread()) >= {"hip_kp", "placement_gain", "motor_time_constant_s"}
     assert "motor_limit_nm" not in paper.gait.unread() and "motor_gain_nms" not in paper.gait.unread()
-    assert {"motor_limit_nm", "motor_solve", "motor_gain_nms"} <= set(EpisodeConfig().gait.unread())
+    assert {"motor_limit_nm", "motor_solve", "motor_gain_nms"} <= set(FAST.gait.unread())
     controller_solved = paper.override({"gait.motor_solve": "controller"})
     assert "motor_gain_nms" in controller_solved.gait.unread()
     assert "motor_time_constant_s" not in controller_solved.gait.unread()
@@ -223,16 +226,20 @@ def test_a_record_written_before_motor_solve_is_read_as_the_controllers_motor_it
     """A record naming hip_drive "motor" without motor_solve (every record before the plant's motor) is read as
     motor_solve "controller"; one that names it as written; a parameter file takes the default ("plant"); the plant's
     motor refuses what it cannot hold (the inter-leg angle, a controller clock of its own), naming the field."""
-    from drake_biped.params import ParameterError, config_of_params, config_of_record
+    from drake_biped.legacy import config_of_record
+    from drake_biped.params import ParameterError, config_of_params
     from drake_biped.resources import load_gait
 
     plant = load_gait("paper").override({"gait.motor_solve": "plant"}).to_dict()
     old = {**plant, "gait": {k: v for k, v in plant["gait"].items() if k not in ("motor_solve", "motor_gain_nms")}}
     assert config_of_record(old, "record").gait.motor_solve == "controller"
     assert config_of_record(plant, "record").gait.motor_solve == "plant"
-    # a parameter file is not a record: its missing fields are the defaults'
-    assert config_of_params(old, "params").gait.motor_solve == "plant"
-    assert config_of_params({"gait": {"hip_kd": 12.0}}, "x").gait.motor_solve == "plant"
+    # a parameter file is not a record: its missing fields are the defaults' (the paper walker's)
+    paper = {**plant, "sim": {k: v for k, v in plant["sim"].items() if k != "controller_clock"}}
+    for solve in ("plant", "controller"):
+        written = {**paper, "gait": {**old["gait"], "motor_solve": solve}}
+        assert config_of_params(written, "params").gait.motor_solve == solve
+    assert config_of_params({"gait": {"torso_kd": 12.0}}, "x").gait.motor_solve == EpisodeConfig().gait.motor_solve
     with pytest.raises(ParameterError, match="hip_joint = 'inter_leg' needs motor_solve 'controller'"):
         _motor("inter_leg", "plant")
     with pytest.raises(ParameterError, match=r"sim.control_period_s = 0.002 with the plant's hip motor"):

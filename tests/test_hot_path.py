@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
+from walkers import fast_config
 
 from drake_biped import controller as ctl
 from drake_biped.control_kernel import MAX_TOUCHDOWNS, touchdown_capacity
@@ -21,7 +22,7 @@ from drake_biped.params import (
 
 
 def _config():
-    return EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=15.0))
+    return fast_config(sim=SimulationParams(distance_m=3.0, max_time_s=15.0))
 
 
 def test_replaying_the_logged_torques_retraces_the_closed_loop(short_walk):
@@ -142,7 +143,7 @@ def test_touchdown_capacity_covers_the_longest_episode():
 def test_a_reused_diagram_gives_the_numbers_of_a_fresh_one():
     """Episodes share a built diagram when their structure matches; whatever ran before, an episode's
     numbers are those of a diagram built for it alone."""
-    a = EpisodeConfig(sim=SimulationParams(distance_m=1.0, max_time_s=15.0))
+    a = fast_config(sim=SimulationParams(distance_m=1.0, max_time_s=15.0))
     b = a.replace(window=TorqueFreeWindow(0.2, 0.5), initial=InitialConditions(hip_angle_rad=0.3, speed_mps=0.4))
     cache = DiagramCache()
     first = run_episode(a, cache=cache)
@@ -158,7 +159,7 @@ def test_a_reused_diagram_gives_the_numbers_of_a_fresh_one():
 
 def test_cache_builds_a_new_diagram_for_a_new_structure():
     cache = DiagramCache(size=2)
-    base = EpisodeConfig(sim=SimulationParams(distance_m=0.2, max_time_s=5.0))
+    base = fast_config(sim=SimulationParams(distance_m=0.2, max_time_s=5.0))
     run_episode(base, cache=cache)
     run_episode(base.replace(sim=SimulationParams(distance_m=0.2, max_time_s=5.0, time_step_s=5e-4,
                                                   control_period_s=5e-4)), cache=cache)
@@ -184,7 +185,7 @@ def test_the_compiled_update_gives_the_numbers_of_the_same_code_run_as_python():
     import subprocess
     import sys
 
-    config = EpisodeConfig(sim=SimulationParams(distance_m=1.3, max_time_s=4.0), window=TorqueFreeWindow(0.1, 0.3))
+    config = fast_config(sim=SimulationParams(distance_m=1.3, max_time_s=4.0), window=TorqueFreeWindow(0.1, 0.3))
     code = ("import json, sys; from drake_biped.episode import run_episode; "
             "from drake_biped.params import EpisodeConfig; "
             "r = run_episode(EpisodeConfig.from_dict(json.loads(sys.argv[1]))); "
@@ -231,7 +232,7 @@ def test_stepping_the_plant_directly_gives_the_simulators_numbers(monkeypatch, c
     """The episode path that calls the plant's step itself (no Simulator, no Python callback) gives the
     Simulator path's walk to the last bit: work, distance, duration, touchdowns, and why it ended; also with
     a kick of the swing hip between two steps."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=1.5, max_time_s=15.0)).replace(**change)
+    config = fast_config(sim=SimulationParams(distance_m=1.5, max_time_s=15.0)).replace(**change)
     simulator = [a for a, _ in _both_paths(monkeypatch, config)]
     assert simulator[0].termination == ending
 

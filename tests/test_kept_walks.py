@@ -3,7 +3,7 @@ map or re-walk resumes where it stopped and writes the record an uninterrupted r
 
 import json
 
-from drake_biped.params import EpisodeConfig
+from walkers import fast_config
 
 
 def _mark_and_lose(folder, marked: str, lost: str, **fields) -> None:
@@ -36,7 +36,7 @@ def test_an_interrupted_time_step_study_resumes_from_its_kept_walks(tmp_path, cl
 def test_an_interrupted_push_margin_map_resumes_from_its_kept_walks(tmp_path, client):
     from drake_biped.experiments import push_margin
 
-    config = EpisodeConfig().override({"sim.distance_m": 3.0, "sim.max_time_s": 10.0})
+    config = fast_config().override({"sim.distance_m": 3.0, "sim.max_time_s": 10.0})
     settings = push_margin.PushMarginSettings(config, (0.2, 0.5), max_force_n=10.0, force_step_n=10.0, phases=1,
                                               settle_s=1.0)
     first = push_margin.run(settings, tmp_path, client, progress=False)

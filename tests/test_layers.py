@@ -21,6 +21,7 @@ LAYERS = {
     "drake_biped.analysis.rewalks": PURE,
     "drake_biped.analysis.grid_ranking": PURE,
     "drake_biped.params": CORE,
+    "drake_biped.legacy": CORE,
     "drake_biped.resources": CORE,
     "drake_biped.records": CORE,
     "drake_biped.versions": CORE,

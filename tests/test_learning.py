@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.cli import main
 from drake_biped.common.executor import dask_client
@@ -36,7 +37,7 @@ def test_trials_get_distinct_reproducible_seeds():
 
 
 def _settings(episodes=4, trials=2):
-    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    config = fast_config(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     return make_settings(config, trials, episodes, seed=3)
 
 
@@ -122,7 +123,7 @@ def test_a_shorter_run_is_replayed_from_a_longer_ones_records(tmp_path, client):
 def test_every_learner_resumes_to_the_uninterrupted_result(tmp_path, learner):
     """Cut inside a CMA-ES generation (6 samples) and inside a PGPE pair: the same records as GARB's, and
     the resumed run ends identical to the uninterrupted one."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    config = fast_config(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     settings = make_settings(config, 1, 7, seed=3, learner=learner)
     with dask_client(workers=1) as client:
         whole, _ = run_learning(tmp_path / "whole", settings, client)
@@ -138,7 +139,7 @@ def test_every_learner_resumes_to_the_uninterrupted_result(tmp_path, learner):
 
 def test_an_unknown_learner_is_refused_before_anything_runs():
     with pytest.raises(ParameterError, match="--learner 'sgd'"):
-        make_settings(EpisodeConfig(), 1, 1, seed=0, learner="sgd")
+        make_settings(fast_config(), 1, 1, seed=0, learner="sgd")
 
 
 def test_resuming_with_other_settings_is_refused(tmp_path):
@@ -213,7 +214,7 @@ def test_run_log_keeps_every_session_and_their_totals(tmp_path):
 def test_compare_learners_puts_the_runs_beside_the_best_window(tmp_path, client):
     from drake_biped.experiments import compare_learners, window_map
 
-    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    config = fast_config(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     window_map.run(window_map.WindowMapSettings(config, t1_max_s=0.1, t2_max_s=0.3, t1_step_s=0.1, t2_step_s=0.1), tmp_path / "map", client,
                    progress=False)
     from drake_biped.common import learning_runs as learning
@@ -261,22 +262,22 @@ def test_a_damaged_trial_record_is_named_with_what_to_do(tmp_path, content, name
 
 
 def test_each_learner_records_its_own_settings():
-    garb = make_settings(EpisodeConfig(), 1, 1, seed=0)["learner"]
+    garb = make_settings(fast_config(), 1, 1, seed=0)["learner"]
     assert set(garb) == {"mean", "variance", "beta", "schedule"}  # GARB's record, as it always was
-    cmaes = make_settings(EpisodeConfig(), 1, 1, seed=0, learner="cmaes")["learner"]
+    cmaes = make_settings(fast_config(), 1, 1, seed=0, learner="cmaes")["learner"]
     assert set(cmaes) == {"mean", "variance", "name", "options"}  # no GARB settings in another learner's
     with pytest.raises(ParameterError, match="beta and schedule are the settings of GARB's learning rate; "
                                              "learner 'pgpe' takes none"):
-        make_settings(EpisodeConfig(), 1, 1, seed=0, learner="pgpe", beta=0.5)
+        make_settings(fast_config(), 1, 1, seed=0, learner="pgpe", beta=0.5)
 
 
 def test_a_record_that_gave_another_learner_garbs_settings_still_resumes():
     from drake_biped.common.learning_runs import _fixed
 
-    new = make_settings(EpisodeConfig(), 1, 1, seed=0, learner="cmaes")
+    new = make_settings(fast_config(), 1, 1, seed=0, learner="cmaes")
     old = {**new, "learner": {**new["learner"], "beta": 0.8, "schedule": [[None, 0.01]]}}
     assert _fixed(old) == _fixed(new)
-    garb = make_settings(EpisodeConfig(), 1, 1, seed=0)
+    garb = make_settings(fast_config(), 1, 1, seed=0)
     assert _fixed({**garb, "learner": {**garb["learner"], "beta": 0.5}}) != _fixed(garb)  # GARB's own count
 
 
@@ -287,7 +288,7 @@ def test_a_variance_wider_than_a_windows_declared_times_is_refused(tmp_path, cap
     assert stop.value.code == 2
     err = capsys.readouterr().err
     assert "--variance 1e+06" in err and "0-10 s" in err
-    make_settings(EpisodeConfig(), 1, 1, 0, variance=100.0)  # a standard deviation of the whole span is taken
+    make_settings(fast_config(), 1, 1, 0, variance=100.0)  # a standard deviation of the whole span is taken
 
 
 def test_one_trial_has_no_spread_to_print(tmp_path):

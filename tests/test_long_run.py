@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.analysis.long_run import long_run_cost, t975
 from drake_biped.hip_motor import DYN_SIZE
@@ -59,9 +60,8 @@ def _kernel_inputs():
     from drake_biped.controller import law_vector
     from drake_biped.diagram import initial_state
     from drake_biped.kinematics import TABLE_I_BODY
-    from drake_biped.params import EpisodeConfig
 
-    config = EpisodeConfig()
+    config = fast_config()
     q, v, _, liftoff = initial_state(config)
     s = np.zeros(ctl.N_STATE)
     s[ctl.STANCE_RIGHT] = s[ctl.CONTACT_RIGHT] = 1.0
@@ -105,16 +105,15 @@ def test_the_default_gait_converges_over_long_walks_and_a_long_control_period_st
     and the long-run C_mt of the three agree within 1 %; at a 10 ms step (and control period) the loop is
     caught diverging."""
     from drake_biped.episode import run_episode
-    from drake_biped.params import EpisodeConfig
 
     costs = []
     for h in (1e-3, 5e-4, 2.5e-4):
-        r = run_episode(EpisodeConfig().override({"sim.time_step_s": h, "sim.distance_m": 110.0,
+        r = run_episode(fast_config().override({"sim.time_step_s": h, "sim.distance_m": 110.0,
                                                   "sim.max_time_s": 600.0}))
         assert r.termination == "distance"
         costs.append(r.long_run()["cost_of_transport"])
     assert max(costs) / min(costs) - 1.0 < 0.01
-    coarse = run_episode(EpisodeConfig().override({"sim.time_step_s": 1e-2, "sim.control_period_s": 1e-2}))
+    coarse = run_episode(fast_config().override({"sim.time_step_s": 1e-2, "sim.control_period_s": 1e-2}))
     assert coarse.termination == "diverged"
 
 

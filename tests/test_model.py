@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.model import JOINT_NAMES, ModelError, add_biped, build_plant, effort_limits
 from drake_biped.paper import TABLE_I_LENGTHS_M, TABLE_I_MASSES_KG
@@ -154,13 +155,13 @@ def test_a_heavier_torso_is_the_mass_of_the_cost_of_transport(tmp_path):
     mass, and C_mt is the positive work over that mass's weight times the distance."""
     import drake_biped.model as model
     from drake_biped.episode import run_episode
-    from drake_biped.params import GRAVITY_MPS2, EpisodeConfig, RobotModel, SimulationParams
+    from drake_biped.params import GRAVITY_MPS2, RobotModel, SimulationParams
 
     heavier = RobotModel.from_file(_model_file(tmp_path, lambda t: t.replace('<mass value="6.646"/>',
                                                                              '<mass value="8.646"/>', 1)))
     assert model.link_masses_of(model.build_plant(model=heavier)).total == pytest.approx(TOTAL_MASS_KG + 2.0,
                                                                                         abs=1e-12)
-    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=1.0, max_time_s=6.0), model=heavier), cache=None)
+    r = run_episode(fast_config(sim=SimulationParams(distance_m=1.0, max_time_s=6.0), model=heavier), cache=None)
     assert r.mass_kg == pytest.approx(12.202, abs=1e-12)
     assert r.distance_m > 0.3
     assert r.cost_of_transport == pytest.approx(r.total_positive_work_j / (12.202 * GRAVITY_MPS2 * r.distance_m))
@@ -304,7 +305,6 @@ def test_near_the_kink_a_foot_meets_one_surface(offset_m):
 
     from drake_biped.diagram import initial_state
     from drake_biped.kinematics import leg_points
-    from drake_biped.params import EpisodeConfig
 
     ground = Ground(slope_rad=0.02, level_length_m=2.0)
     builder = DiagramBuilder()
@@ -312,7 +312,7 @@ def test_near_the_kink_a_foot_meets_one_surface(offset_m):
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     plant = handles.plant
-    q, *_ = initial_state(EpisodeConfig())
+    q, *_ = initial_state(fast_config())
     q = q.copy()
     q[1] += 0.3  # lift the robot; then put the right heel's sphere where it is wanted
     heel = leg_points(q[0], q[1], q[2], q[6], q[7], q[8])
@@ -332,11 +332,11 @@ def test_near_the_kink_a_foot_meets_one_surface(offset_m):
 
 def test_a_walk_with_a_level_length_on_level_ground_is_the_walk_without_it():
     from drake_biped.episode import run_episode
-    from drake_biped.params import EpisodeConfig, SimulationParams
+    from drake_biped.params import SimulationParams
 
     sim = SimulationParams(distance_m=1.0, max_time_s=5.0)
-    plain = run_episode(EpisodeConfig(sim=sim))
-    with_level = run_episode(EpisodeConfig(sim=sim, ground=Ground(level_length_m=5.0)))
+    plain = run_episode(fast_config(sim=sim))
+    with_level = run_episode(fast_config(sim=sim, ground=Ground(level_length_m=5.0)))
     assert with_level.cost_of_transport == plain.cost_of_transport
     assert with_level.distance_m == plain.distance_m
 
@@ -410,17 +410,17 @@ def test_the_motors_limits_are_the_models_and_the_work_is_of_the_applied_torque(
     from drake_biped.episode import run_episode
     from drake_biped.kinematics import B_HIP_EFFORT, B_KNEE_EFFORT
     from drake_biped.model import body_of_model
-    from drake_biped.params import EpisodeConfig, RobotModel, SimulationParams
+    from drake_biped.params import RobotModel, SimulationParams
 
     weak = RobotModel.from_file(_model_file(tmp_path, _hips_effort("25")))
     body = body_of_model(weak)
     assert body[B_HIP_EFFORT] == 25.0 and body[B_KNEE_EFFORT] == 30.0
-    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=10.0), model=weak),
+    r = run_episode(fast_config(sim=SimulationParams(distance_m=3.0, max_time_s=10.0), model=weak),
                     record_trajectory=True, cache=None)
     hips = [JOINT_NAMES.index("left_hip"), JOINT_NAMES.index("right_hip")]
     actuation = r.trajectory["actuation"]
     assert np.max(np.abs(actuation[:, hips])) <= 25.0 + 1e-12
-    strong = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=10.0)),
+    strong = run_episode(fast_config(sim=SimulationParams(distance_m=3.0, max_time_s=10.0)),
                          record_trajectory=True, cache=None)
     assert np.max(np.abs(strong.trajectory["actuation"][:, hips])) > 25.0  # the limit binds
     # the work of the applied torques, held over each control period, from the logged states
@@ -472,22 +472,21 @@ def test_the_default_contact_is_drakes_default_material_without_the_near_rigid_r
     last bit), with SAP's near-rigid regime off; a record written before the contact was recorded is walked
     again on Drake's defaults, near-rigid regime included."""
     from drake_biped.episode import run_episode
+    from drake_biped.legacy import config_of_record
     from drake_biped.params import (
         DRAKE_DEFAULT_CONTACT,
         ContactParams,
-        EpisodeConfig,
         SimulationParams,
-        config_of_record,
     )
 
     sim = SimulationParams(distance_m=1.0, max_time_s=5.0)
-    explicit = run_episode(EpisodeConfig(sim=sim), cache=None)
-    drakes = run_episode(EpisodeConfig(sim=sim, contact=ContactParams(None, None, None, 0.0)), cache=None)
+    explicit = run_episode(fast_config(sim=sim), cache=None)
+    drakes = run_episode(fast_config(sim=sim, contact=ContactParams(None, None, None, 0.0)), cache=None)
     assert explicit.cost_of_transport == drakes.cost_of_transport
-    old = EpisodeConfig(sim=sim).to_dict()
+    old = fast_config(sim=sim).to_dict()
     old.pop("contact")
     assert config_of_record(old).contact == DRAKE_DEFAULT_CONTACT
-    assert config_of_record(EpisodeConfig(sim=sim).to_dict()).contact == ContactParams()
+    assert config_of_record(fast_config(sim=sim).to_dict()).contact == ContactParams()
     legacy = run_episode(config_of_record(old), cache=None)
     assert legacy.cost_of_transport != explicit.cost_of_transport  # the regime changes the contact
 
@@ -539,7 +538,7 @@ def test_a_models_file_is_found_or_named_with_where_it_was_looked_for(tmp_path):
     """A mesh named by an absolute path resolves; a missing one, relative or absolute, and a package nobody
     declared are ModelError naming the file and where it was looked for, through the API as on the command line."""
     from drake_biped.episode import run_episode
-    from drake_biped.params import EpisodeConfig, RobotModel
+    from drake_biped.params import RobotModel
 
     (tmp_path / "box.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
 
@@ -557,7 +556,7 @@ def test_a_models_file_is_found_or_named_with_where_it_was_looked_for(tmp_path):
     for uri, where in cases:
         model = with_mesh(uri, "mine.urdf")
         with pytest.raises(ModelError) as raised:
-            run_episode(EpisodeConfig(model=model))
+            run_episode(fast_config(model=model))
         assert f"the model mine.urdf names the file {uri!r}" in str(raised.value)
         assert where in str(raised.value) and "\n" not in str(raised.value)
     text = with_mesh("box.obj", "mine.urdf").text  # a relative name without the folder to read it against
@@ -574,13 +573,13 @@ def test_an_sdformat_model_of_the_shipped_robot_walks_as_the_urdf(tmp_path):
     from drake_biped.episode import run_episode
     from drake_biped.kinematics import TABLE_I_BODY
     from drake_biped.model import body_of_model
-    from drake_biped.params import EpisodeConfig, RobotModel
+    from drake_biped.params import RobotModel
     from drake_biped.resources import shipped_model_file
 
     path = tmp_path / "biped.sdf"
     path.write_text(urdf_to_sdf(shipped_model_file().read_text()))
     model = RobotModel.from_file(path)
     assert np.max(np.abs(body_of_model(model) - TABLE_I_BODY)) < 1e-12
-    sdf, urdf = run_episode(EpisodeConfig(model=model)), run_episode(EpisodeConfig())
+    sdf, urdf = run_episode(fast_config(model=model)), run_episode(fast_config())
     assert sdf.termination == urdf.termination == "distance" and len(sdf.steps) == len(urdf.steps)
     assert sdf.cost_of_transport == pytest.approx(urdf.cost_of_transport, rel=2e-3)

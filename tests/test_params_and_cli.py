@@ -53,16 +53,23 @@ def test_config_round_trip():
 
 
 def test_a_partial_section_keeps_the_default_gait(tmp_path):
-    """A parameter file that names one gain changes that gain of the default gait; the rest of the section
-    is the default configuration's, not the bare class's (whose gait does not walk)."""
-    from drake_biped.params import GaitParams
+    """A parameter file that names one gain changes that gain of the default gait, the paper's walker; the
+    rest of the section is its. The default is one walker throughout: each section class's defaults are the
+    paper walker's, its CPG Table III as `paper.TABLE_III` prints it."""
+    from drake_biped.paper import TABLE_III
+    from drake_biped.params import CpgParams, GaitParams, InitialConditions
     from drake_biped.resources import load_gait
 
     path = tmp_path / "one_gain.json"
-    path.write_text(json.dumps({"gait": {"hip_kd": 12.0}, "cpg": {"kappa": 2.0}}))
+    path.write_text(json.dumps({"gait": {"torso_kd": 12.0}, "cpg": {"kappa": 2.0}}))
     loaded = load_gait(path)
-    assert loaded == EpisodeConfig().override({"gait.hip_kd": 12.0, "cpg.kappa": 2.0})
-    assert loaded.gait.hip_kp == EpisodeConfig().gait.hip_kp != GaitParams().hip_kp
+    assert loaded == EpisodeConfig().override({"gait.torso_kd": 12.0, "cpg.kappa": 2.0})
+    assert loaded.gait.torso_kp == EpisodeConfig().gait.torso_kp
+    assert EpisodeConfig() == load_gait("paper")
+    assert (EpisodeConfig().cpg, EpisodeConfig().gait, EpisodeConfig().initial) == (
+        CpgParams(), GaitParams(), InitialConditions())
+    assert {name: getattr(CpgParams(), name) for name in ("alpha", "u_a", "u_eta", "u_r", "kappa")} == {
+        name: TABLE_III[name] for name in ("alpha", "u_a", "u_eta", "u_r", "kappa")}
     with pytest.raises(ParameterError, match="bogus"):
         EpisodeConfig.from_dict({"gait": {"bogus": 1.0}})
 
@@ -136,7 +143,7 @@ def test_the_controller_clock_is_the_plant_step_by_default_and_every_record_name
     old = {"time_step_s": 5e-4, "control_period_s": 1e-3}  # a record from before the clock was recorded
     assert clock_of_record(old) == ("fixed rate", 1e-3)
     assert EpisodeConfig.from_dict({"sim": old}).sim.update_period_s == 1e-3
-    from drake_biped.params import config_of_record
+    from drake_biped.legacy import config_of_record
 
     # a record from before: its loop at its own step reads as the paper's clock; a slower loop stays fixed
     legacy = {"sim": {"time_step_s": 1e-3, "control_period_s": 1e-3}, "contact": {}}

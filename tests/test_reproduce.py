@@ -240,8 +240,8 @@ def test_the_packaged_full_run_is_the_shipped_full_runs_verdicts():
 
 
 def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
-    """A full run measured on another gait than today's default is named by its shipped gait (or "another
-    gait"), so that its column is not read as the default gait's; on the default gait, nothing is said."""
+    """A full run measured on another gait than the one this run walks is named by its shipped gait (or
+    "another gait"), so that its column is not read as this gait's; on the same gait, nothing is said."""
     from drake_biped.analysis.reproduce_report import full_run_gait, full_run_gait_name
     from drake_biped.params import EpisodeConfig
     from drake_biped.resources import load_gait
@@ -249,18 +249,19 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
     def digest(config):
         return {"checks": {"learn": {"config": config.to_dict()}}}
 
-    assert full_run_gait(digest(EpisodeConfig())) is None
+    assert full_run_gait(digest(EpisodeConfig())) is None  # the default is the paper's walker
     assert full_run_gait(digest(load_gait("paper_servo"))) == "`paper_servo`"
-    assert full_run_gait(digest(EpisodeConfig().override({"u_a": 2.0}))) == "another gait"
+    assert full_run_gait(digest(EpisodeConfig().override({"u_a": 2.2}))) == "another gait"
     assert full_run_gait({"checks": {}}) is None and full_run_gait(None) is None
-    # a run on another gait names the default gait's full run, and nothing when the full run is its own
-    assert full_run_gait(digest(EpisodeConfig()), "paper") == "`default`"
-    assert full_run_gait(digest(load_gait("paper")), "paper") is None
+    # a run on another gait names the full run's gait, and nothing when the full run is its own
+    assert full_run_gait(digest(load_gait("fast_servo")), "paper") == "`fast_servo`"
+    assert full_run_gait(digest(load_gait("paper")), "fast_servo") == "`paper`"
+    assert full_run_gait(digest(load_gait("fast_servo")), "fast_servo") is None
     # and the quick report points at the folder of the gait's committed full run
     from drake_biped.analysis.reproduce_report import full_run_records
 
     assert full_run_records(digest(load_gait("paper"))) == "benchmarks/results/reproduce-paper"
-    assert full_run_records(digest(EpisodeConfig())) == "benchmarks/results/reproduce-full"
+    assert full_run_records(digest(load_gait("fast_servo"))) == "benchmarks/results/reproduce-full"
     # the gait a reproduction walks unless told is the one whose full run ships
     from drake_biped.experiments.reproduce import DEFAULT_STORY
     from drake_biped.resources import full_run_digest
@@ -271,8 +272,8 @@ def test_the_quick_report_names_the_full_runs_gait_when_it_is_not_the_default():
 
 def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
     """`--gait paper`: every step's walker is the shipped `paper` gait (its own plant step), its matched
-    exploration and its t1 sweep are its story's, the shipped full run (the default gait's) is not checked on
-    it, and a folder of one gait's run refuses another's."""
+    exploration and its t1 sweep are its story's, the shipped full run (the paper walker's) is not checked on
+    `fast_servo`, and a folder of one gait's run refuses another's."""
     import dataclasses
 
     from drake_biped.experiments.reproduce import STORIES, ReproduceSettings, story_of
@@ -283,19 +284,20 @@ def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
     shipped = load_gait("paper")
     assert paper.base == shipped and paper.level.cpg == shipped.cpg and paper.level.gait == shipped.gait
     assert paper.level.sim == dataclasses.replace(shipped.sim, distance_m=QUICK.distance_m)
-    assert Reproduction(tmp_path, QUICK, None, gait="default").base == EpisodeConfig()
-    assert Reproduction(tmp_path, QUICK, None).base == shipped  # the paper's walker unless told
-    # the default story's sweep is fixed; the paper's follows the learned window, ending before its t2
-    assert STORIES["default"].t1_values((0.37, 0.86), 9)[::8] == (0.30, 0.46)
+    assert Reproduction(tmp_path, QUICK, None, gait="fast_servo").base == load_gait("fast_servo")
+    assert Reproduction(tmp_path, QUICK, None).base == shipped == EpisodeConfig()  # the paper's walker unless told
+    # fast_servo's sweep is fixed; the paper's follows the learned window, ending before its t2
+    assert STORIES["fast_servo"].t1_values((0.37, 0.86), 9)[::8] == (0.30, 0.46)
     values = STORIES["paper"].t1_values((0.1, 0.2), 5)
     assert values[0] == 0.02 and values[-1] == 0.18 and len(set(values)) == 5
     assert STORIES["paper"].t1_values((0.02, 0.3), 3)[0] == 0.0
-    # the time-step study's second window: the default story's is the study's own (its committed run's
-    # settings still match), the paper walker's one of its own map's windows that walk
+    # the time-step study's second window: fast_servo's is its committed run's (0.3-0.6 s), the paper walker's
+    # (the study's own, `time-step` without --params) one of its own map's windows that walk
     from drake_biped.experiments.time_step import WALKS
 
-    assert STORIES["default"].study_window == WALKS[-1] and STORIES["paper"].study_window == (0.5, 0.6)
-    assert "full_run" in steps_of(QUICK) and "full_run" not in steps_of(QUICK, "default")
+    assert STORIES["fast_servo"].study_window == (0.3, 0.6) and STORIES["paper"].study_window == (0.5, 0.6) == \
+        WALKS[-1]
+    assert "full_run" in steps_of(QUICK) and "full_run" not in steps_of(QUICK, "fast_servo")
     with pytest.raises(ParameterError, match="--gait 'slow'"):
         story_of("slow")
     with pytest.raises(ParameterError, match="--gait 'slow'"):
@@ -304,9 +306,9 @@ def test_a_story_runs_on_its_own_gait_and_a_folder_keeps_one_gait(tmp_path):
     check_out(tmp_path, QUICK, "paper")
     check_out(tmp_path, QUICK)  # the paper's walker unless told
     with pytest.raises(ParameterError, match="holds a run on the 'paper' gait"):
-        check_out(tmp_path, QUICK, "default")
-    check_out(tmp_path / "d", QUICK, "default")
-    with pytest.raises(ParameterError, match="holds a run on the 'default' gait"):
+        check_out(tmp_path, QUICK, "fast_servo")
+    check_out(tmp_path / "d", QUICK, "fast_servo")
+    with pytest.raises(ParameterError, match="holds a run on the 'fast_servo' gait"):
         check_out(tmp_path / "d", QUICK)
 
 
@@ -336,32 +338,33 @@ def test_the_quick_run_walks_the_full_runs_learned_windows_again_and_gets_its_nu
 
 def test_every_shipped_gait_says_why_it_exists_and_the_report_reads_it_from_the_file():
     """Every gait file has an `about` with why, where from and its claim; the report's closing section lists
-    the gaits other than the default with their files' reasons; gaits/default.json is EpisodeConfig()."""
+    the gaits other than the default with their files' reasons; gaits/paper.json is EpisodeConfig()."""
     import json
 
     from drake_biped.analysis.reproduce_report import other_gaits_section
     from drake_biped.params import EpisodeConfig
     from drake_biped.resources import gait_about, gait_names, gait_path, load_gait
 
-    assert "default" in gait_names()
+    assert "paper" in gait_names()
     for name in gait_names():
         about = json.loads(gait_path(name).read_text())["about"]
         assert about == gait_about(name) and all(w in about for w in ("Why:", "Source:", "Claim:")), name
     section = "\n".join(other_gaits_section())
-    assert all(f"| `{name}` | {gait_about(name)} |" in section for name in gait_names() if name != "default")
-    assert "| `default` |" not in section
-    assert load_gait("default") == EpisodeConfig()
+    assert all(f"| `{name}` | {gait_about(name)} |" in section for name in gait_names() if name != "paper")
+    assert "| `paper` |" not in section
+    assert load_gait("paper") == EpisodeConfig()
 
 
 def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp_path):
     import json
 
     from drake_biped.analysis.reproduce_report import window_name
-    from drake_biped.experiments.reproduce import LEVEL_WINDOW
+    from drake_biped.resources import gait_compare_window
 
-    r = Reproduction(tmp_path, SMOKE, None, log=lambda _: None, gait="default")
-    assert r.learned_window() == (LEVEL_WINDOW, "no trial learned one and no window of the map walks", None)
-    assert window_name(r.learned_window()[1]) == "the default gait's learned window"
+    r = Reproduction(tmp_path, SMOKE, None, log=lambda _: None, gait="fast_servo")
+    declared, source = gait_compare_window("fast_servo")
+    assert r.learned_window() == (declared, f"no trial learned one and no window of the map walks: {source}", None)
+    assert window_name(r.learned_window()[1]) == "the window its gait file declares"
     (tmp_path / "window_map").mkdir()
     (tmp_path / "window_map" / "summary.json").write_text(json.dumps({"best": {"t1": 0.31234, "t2": 0.9}}))
     assert r.learned_window()[:2] == ((0.3123, 0.9), "the window map's cheapest (no trial learned one)")
@@ -382,18 +385,18 @@ def test_the_learned_window_is_the_best_learned_trial_else_the_maps_cheapest(tmp
     assert r.learned_window() == ((0.0, 0.9), "learned (learn, trial 3)", tmp_path / "learn" / "learning.json")
 
 
-def test_the_2deg_grid_raises_the_default_gaits_cpg_as_table_vii_does():
+def test_the_2deg_grid_raises_the_story_gaits_cpg_as_table_vii_does():
     from drake_biped.experiments.reproduce import FULL
-    from drake_biped.params import EpisodeConfig
+    from drake_biped.resources import load_gait
 
-    c, g = EpisodeConfig().cpg, EpisodeConfig().gait
-    axes = {a.name: a.values for a in Reproduction(Path("."), FULL, None, gait="default").slope_axes()}
+    c, g = load_gait("fast_servo").cpg, load_gait("fast_servo").gait
+    axes = {a.name: a.values for a in Reproduction(Path("."), FULL, None, gait="fast_servo").slope_axes()}
     assert len(axes) == 5 and math.prod(len(v) for v in axes.values()) == 64
     for k in ("u_a", "u_r", "kappa"):
         assert axes[f"cpg.{k}"] == (getattr(c, k), round(1.25 * getattr(c, k), 4))
     assert axes["gait.torso_pitch_rad"][0] == g.torso_pitch_rad and max(axes["gait.torso_pitch_rad"]) == \
         g.torso_pitch_rad  # leaning further forward only
-    quick = {a.name: a.values for a in Reproduction(Path("."), SMOKE, None, gait="default").slope_axes()}
+    quick = {a.name: a.values for a in Reproduction(Path("."), SMOKE, None, gait="fast_servo").slope_axes()}
     assert set(quick) == {"gait.torso_pitch_rad", "cpg.u_a"} and all(len(v) == 2 for v in quick.values())
     paper = {a.name: a.values for a in Reproduction(Path("."), FULL, None).slope_axes()}
     assert paper["cpg.u_a"] == (2.0, 2.5) and paper["cpg.u_r"] == (2.1, 2.625) and paper["cpg.kappa"] == (1.8, 2.25)
@@ -426,10 +429,10 @@ def test_table_iii_ranks_among_the_grids_points_by_the_grids_order(tmp_path):
     assert table_iii_rank(tmp_path) == (2, 5)
 
 
-@pytest.mark.parametrize("gait", ["paper", "default"])
+@pytest.mark.parametrize("gait", ["paper", "fast_servo"])
 def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monkeypatch, gait):
     """The report of each committed full run's records (the shipped one, the paper's walker's, and the default
-    gait's) names its gait where a section names the gait (a loop over the slope claims once left its last
+    gait, fast_servo's) names its gait where a section names the gait (a loop over the slope claims once left its last
     claim's words in the grid and window-map sections)."""
     from drake_biped.analysis import reproduce_report
     from drake_biped.analysis.reproduce_report import FULL_RUN_RECORDS, report_markdown
@@ -442,7 +445,7 @@ def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monk
     summaries = {step: read_kept(out / step / "summary.json") for step in steps_of(FULL, gait)}
     monkeypatch.setattr(reproduce_report, "summary_figure", lambda *a, **k: None)  # the records stay as committed
     text, verdicts = report_markdown(out, summaries, FULL, {}, gait, STORIES[gait].why)
-    name = "the default gait" if gait == "default" else f"the `{gait}` gait"
+    name = f"the `{gait}` gait"
     assert f"## Torque-free windows of {name} (`window_map/`)" in text
     assert f"Table III itself (with {name}'s other gains)" in text
     assert "Slope story" not in text.split("## Experiment 1")[0].split("| what | paper |")[0]

@@ -93,12 +93,15 @@ def test_walk_of_a_record_says_how_its_number_compares(tmp_path, capsys):
 
     from drake_biped.cli import main
 
-    assert main(["walk", "--params", "default", "--distance", "0.5", "--no-animation", "--out",
+    assert main(["walk", "--params", "fast_servo", "--distance", "0.5", "--no-animation", "--out",
                  str(tmp_path / "a")]) == 0
     record_path = tmp_path / "a" / "result.json"
     capsys.readouterr()
     assert main(["walk", "--params", str(record_path), "--no-animation", "--out", str(tmp_path / "b")]) == 0
-    line = [x for x in capsys.readouterr().out.splitlines() if x.startswith("record ")]
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("gait: fast_servo (sha256 ")  # the record's walker, named by what it walks
+    assert json.loads((tmp_path / "b" / "result.json").read_text())["gait"]["name"] == "fast_servo"
+    line = [x for x in out if x.startswith("record ")]
     assert len(line) == 1 and "equal to the last digit (the record's machine: compared to the last digit)" in line[0]
     record = json.loads(record_path.read_text())
     record["versions"]["machine"]["cpu"] = "another CPU"

@@ -5,10 +5,11 @@ import json
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.analysis.rewalks import CHANGES, HOLD_SAVING, headline, markdown, summary
 from drake_biped.common.walks import changed, rewalk
-from drake_biped.params import EpisodeConfig, ParameterError, SimulationParams
+from drake_biped.params import ParameterError, SimulationParams
 
 
 def _row(cmt, fell=False):
@@ -73,7 +74,7 @@ def test_no_saving_where_the_walk_without_a_window_falls():
 
 
 def test_the_changes_halve_the_plant_step_and_scale_the_initiation_speed():
-    config = EpisodeConfig()
+    config = fast_config()
     half = changed(config, "half_step")
     assert half.sim.time_step_s == 0.5 * config.sim.time_step_s
     assert half.sim.update_period_s == half.sim.time_step_s  # the paper's clock: the controller refined with it
@@ -92,7 +93,7 @@ def test_the_rewalk_command_repeats_a_learning_runs_own_rewalks(tmp_path, client
     from drake_biped.cli import main
     from drake_biped.common import learning_runs as learning
 
-    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    config = fast_config(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     settings = learning.LearningSettings(config, trials=1, episodes=2, mean=(0.1, 0.4), variance=1e-6)
     record = learning.run(settings, tmp_path / "learn", client, progress=False, rewalk_distance_m=0.6)
     rewalks = record["evaluation"]["rewalks"]
@@ -113,7 +114,7 @@ def test_the_rewalk_command_repeats_a_learning_runs_own_rewalks(tmp_path, client
 def test_an_interrupted_rewalk_resumes_from_the_walks_it_kept(tmp_path, client):
     """Each walk is kept as it finishes: a rerun reads a kept walk back (a marked one shows its mark), walks
     again only what is missing, and gives the first record where nothing was changed."""
-    config = EpisodeConfig(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
+    config = fast_config(sim=SimulationParams(distance_m=0.6, max_time_s=5.0))
     learned = [{"trial": 0, "t1": 0.1, "t2": 0.4}]
     first = rewalk(config, learned, client, distance_m=0.6, keep=tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{c}-{k}.json" for c in CHANGES

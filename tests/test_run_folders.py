@@ -6,9 +6,10 @@ import json
 import threading
 
 import pytest
+from walkers import FAST, fast_config
 
 from drake_biped.cli import main
-from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.params import ParameterError
 from drake_biped.records import LOCK_FILE, RUN_FILE, claim_folder
 
 
@@ -122,7 +123,7 @@ def test_a_window_map_keeps_every_finished_episode_and_sets_a_damaged_log_aside(
     run again, and the map is the same."""
     from drake_biped.experiments.window_map import WindowMapSettings, run
 
-    settings = WindowMapSettings(EpisodeConfig().override({"sim.distance_m": 0.3}), t1_max_s=0.1, t2_max_s=0.3,
+    settings = WindowMapSettings(fast_config().override({"sim.distance_m": 0.3}), t1_max_s=0.1, t2_max_s=0.3,
                                  t1_step_s=0.1, t2_step_s=0.1)
     out = tmp_path / "wm"
     first = run(settings, out, client, progress=False)
@@ -158,8 +159,8 @@ def test_a_scheduler_without_workers_is_said_within_seconds(monkeypatch):
 
 
 @pytest.mark.parametrize("call, match", [
-    (lambda: EpisodeConfig().override({"seed": 1}).seed == 1 or None, None),
-    (lambda: __import__("drake_biped.episode", fromlist=["x"]).run_episode(EpisodeConfig(), cache="x"),
+    (lambda: fast_config().override({"seed": 1}).seed == 1 or None, None),
+    (lambda: __import__("drake_biped.episode", fromlist=["x"]).run_episode(fast_config(), cache="x"),
      r"run_episode: cache must be a DiagramCache or None, got str 'x'"),
     (lambda: __import__("drake_biped.episode", fromlist=["x"]).run_episode("default"),
      r"run_episode: config must be an EpisodeConfig"),
@@ -192,7 +193,8 @@ def test_foreign_records_are_named_not_a_key_error(tmp_path):
         gait_search._check_log(gait_search._read_log(log), settings, "es", log)
     log.write_text(json.dumps({"generation": 0, "parent": {}, "parent_score": 0.1, "objective": "walk",
                                "sigma": 0.1, "mutations": "default", "seed": 0, "policy_draws": 12}) + "\n")
-    other = gait_search.GaitSearchSettings(objective="hold", sigma=0.3)
+    # (a log of the servo's mutation set by its former name, "default")
+    other = gait_search.GaitSearchSettings(config=FAST, objective="hold", sigma=0.3)
     with pytest.raises(ParameterError, match=r"begun with other settings \(objective 'walk' there, 'hold' here; "
                                              r"sigma 0.1 there, 0.3 here\)"):
         gait_search._check_log(gait_search._read_log(log), other, "es", log)

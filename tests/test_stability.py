@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.analysis.stability_report import report_markdown, write_stability_outputs
 from drake_biped.experiments.stability import (
@@ -43,7 +44,7 @@ def test_trials_vary_the_initiation_within_the_spread_reproducibly():
 
 def test_six_cells_with_the_right_window_and_push():
     s = StabilitySettings(window=(0.2, 0.5), trials=3)
-    jobs = cell_configs(EpisodeConfig(), s)
+    jobs = cell_configs(fast_config(), s)
     assert len(jobs) == 18
     for condition, kind, _k, c in jobs:
         assert c.window.active == (condition == "with")
@@ -126,7 +127,7 @@ def test_a_short_distance_is_refused_once_with_the_distance_that_is_enough():
     import re
 
     def refusal(distance_m, kicks=(0.005,)):
-        config = EpisodeConfig().override({"sim.distance_m": distance_m})
+        config = fast_config().override({"sim.distance_m": distance_m})
         try:
             StabilitySettings(trials=1, config=config, jacobian_kicks=kicks).check_walks_reach()
         except ParameterError as exc:
@@ -145,7 +146,7 @@ def test_the_window_compared_is_the_walked_gaits_and_named_or_the_command_asks_f
     comes from; a gait that declares none is refused (exit 2) with what to give, never given another's."""
     from drake_biped.cli import build_parser
     from drake_biped.experiments import push_margin, stability
-    from drake_biped.params import LEARNED_WINDOW_S
+    from drake_biped.params import DEFAULT_WINDOW_S
     from drake_biped.resources import gait_compare_window, gait_path
 
     def settings(*argv):
@@ -156,13 +157,15 @@ def test_the_window_compared_is_the_walked_gaits_and_named_or_the_command_asks_f
         paper = settings(command, "--params", "paper")
         assert paper.window == (0.1, 0.2) and "window map" in paper.window_source
         assert capsys.readouterr().out.startswith("window 0.1-0.2 s: the cheapest window of this gait's window map")
-        assert settings(command).window == LEARNED_WINDOW_S
+        assert settings(command).window == DEFAULT_WINDOW_S == (0.1, 0.2)  # no --params: the paper's walker's
+        assert capsys.readouterr().out.rstrip().endswith("(gait file paper)")
+        fast = settings(command, "--params", "fast_servo")
+        assert fast.window == gait_compare_window("fast_servo")[0] == (0.3672, 0.8629)
         assert "learned" in capsys.readouterr().out
         with pytest.raises(ParameterError, match="--params paper_servo: the gait declares no window.*--t1 and --t2"):
             settings(command, "--params", "paper_servo")
         assert settings(command, "--params", "paper_servo", "--t1", "0.2", "--t2", "0.3").window == (0.2, 0.3)
         assert capsys.readouterr().out == "window 0.2-0.3 s: --t1/--t2\n"
-    assert gait_compare_window("default")[0] == LEARNED_WINDOW_S
     # the key is no parameter of the walk: the file still reads as a configuration
     assert EpisodeConfig.from_dict(json.loads(gait_path("paper").read_text())).window.active is False
     bad = tmp_path / "bad.json"
@@ -175,7 +178,7 @@ def test_the_window_compared_is_the_walked_gaits_and_named_or_the_command_asks_f
 def test_a_rerun_recomputes_nothing(tmp_path):
     from drake_biped.common.executor import dask_client
 
-    base = EpisodeConfig(sim=SimulationParams(distance_m=1.2, max_time_s=6.0))
+    base = fast_config(sim=SimulationParams(distance_m=1.2, max_time_s=6.0))
     s = StabilitySettings(trials=1, steady_from_step=1, bootstrap=0)
     seen = []
     with dask_client(workers=1) as client:
@@ -219,7 +222,7 @@ def test_push_margin_is_the_largest_force_every_phase_survives_however_survival_
         return out
 
     monkeypatch.setattr(executor, "map_ordered", fake_map)
-    settings = push_margin.PushMarginSettings(EpisodeConfig().override({"sim.distance_m": 12.0}), (0.2, 0.5),
+    settings = push_margin.PushMarginSettings(fast_config().override({"sim.distance_m": 12.0}), (0.2, 0.5),
                                               max_force_n=40.0, force_step_n=5.0, phases=4, settle_s=5.0)
     assert settings.forces == [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0] and settings.episodes == 128
     record = push_margin.push_margin(settings, client=None)
@@ -278,13 +281,13 @@ def test_finite_difference_jacobian_recovers_a_known_step_map():
     j_true = a_with([0.3 + 0.2j, 0.3 - 0.2j])
     m = np.array([[0.8, 0.05], [-2.0, 0.9]])  # a kick moves both section coordinates
     client = _LinearStepClient(m, j_true, np.array([0.98, 2.85]), np.array([0.98, 2.85]))
-    fd = finite_difference_jacobian(EpisodeConfig(), client, step=8, angle_rad=0.005, rate_radps=0.05)
+    fd = finite_difference_jacobian(fast_config(), client, step=8, angle_rad=0.005, rate_radps=0.05)
     np.testing.assert_allclose(fd["jacobian"], j_true, atol=1e-9)
     assert fd["spectral_radius"] == pytest.approx(abs(0.3 + 0.2j), abs=1e-9)
     assert fd["relative_residual"] < 1e-9 and fd["kicks_lost"] == 0
     assert fd["kick_time_s"] == pytest.approx(6.4 - 0.03)
     # Jumps as large as the response leave most of it unexplained, and the residual says so.
-    noisy = finite_difference_jacobian(EpisodeConfig(), _LinearStepClient(m, j_true, client.x0, client.y0, jump=0.01),
+    noisy = finite_difference_jacobian(fast_config(), _LinearStepClient(m, j_true, client.x0, client.y0, jump=0.01),
                                        step=8, angle_rad=0.005, rate_radps=0.05)
     assert noisy["relative_residual"] > 0.3
 

@@ -1,6 +1,7 @@
 """The time-step study's rule for choosing the default step, on results whose answer is known."""
 
 import pytest
+from walkers import fast_config
 
 from drake_biped.analysis import time_step_report
 from drake_biped.cli import main
@@ -94,7 +95,6 @@ def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp
     refused before any walk, and the default steps are those that divide it."""
     from drake_biped.common import executor
     from drake_biped.experiments import time_step
-    from drake_biped.params import EpisodeConfig
 
     seen = []
 
@@ -105,7 +105,7 @@ def test_a_fixed_rate_loop_is_refined_over_the_plant_step_alone(monkeypatch, tmp
                  "real_time_factor": 5.0} for _ in items]
 
     monkeypatch.setattr(executor, "map_ordered", fake_map)
-    fixed = EpisodeConfig().override({"sim.control_period_s": 1e-3})
+    fixed = fast_config().override({"sim.control_period_s": 1e-3})
     time_step.study([0.00025, 0.0005, 0.001], 0.00025, 10.0, None, progress=False, config=fixed, windows=[])
     assert sorted({(c["sim"]["time_step_s"], c["sim"]["update_period_s"], c["sim"]["controller_clock"])
                    for c in seen}) == [(0.00025, 0.001, "fixed rate"), (0.0005, 0.001, "fixed rate"),

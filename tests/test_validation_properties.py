@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 import drake_biped as db
 from drake_biped import params
 from drake_biped.cli import main
+from drake_biped.legacy import config_of_record
 from drake_biped.params import EpisodeConfig, GaitParams, ParameterError, TorqueFreeWindow
 from drake_biped.resources import gait_names, gait_path, load_gait
 
@@ -191,7 +192,7 @@ def test_a_window_that_never_opens_is_refused_where_a_user_gives_it(window):
     for config in (EpisodeConfig(window=TorqueFreeWindow(t1, t2)),
                    EpisodeConfig().override({"t1": t1, "t2": t2}, sampled=True),
                    EpisodeConfig.from_dict({"window": {"start_s": t1, "end_s": t2}}),
-                   params.config_of_record({"window": {"start_s": t1, "end_s": t2}})):
+                   config_of_record({"window": {"start_s": t1, "end_s": t2}})):
         assert not config.window.active and config.as_walked().window == TorqueFreeWindow()
 
 

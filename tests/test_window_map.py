@@ -1,15 +1,16 @@
 """The window map's grid is the gait's own: placed by the step period of its walk without a window."""
 
 import pytest
+from walkers import fast_config
 
 from drake_biped.experiments.window_map import PAST_TOUCHDOWN, WindowMapSettings, run
-from drake_biped.params import EpisodeConfig, ParameterError
+from drake_biped.params import ParameterError
 
 
 def test_a_map_left_to_the_gait_spans_its_whole_step_and_past_touchdown(tmp_path, client):
     """The default gait (its steps about 0.42 s): t1 runs to the step period, t2 past it, to 1.5 x; the grid and
     the period are in the record; the baseline is walked once (kept), not again for the grid."""
-    config = EpisodeConfig().override({"sim.distance_m": 2.0})
+    config = fast_config().override({"sim.distance_m": 2.0})
     record = run(WindowMapSettings(config, t1_step_s=0.2, t2_step_s=0.2), tmp_path / "wm", client, progress=False)
     grid, period = record["grid"], record["baseline"]["step_period_s"]
     assert 0.35 < period < 0.5 and grid["step_period_s"] == period

@@ -5,14 +5,15 @@ import json
 
 import numpy as np
 import pytest
+from walkers import fast_config
 
 from drake_biped.episode import EpisodeResult, run_episode
 from drake_biped.model import JOINT_NAMES, ROLES
-from drake_biped.params import EpisodeConfig, SimulationParams, TorqueFreeWindow
+from drake_biped.params import SimulationParams, TorqueFreeWindow
 from drake_biped.resources import load_gait
 
 WALKS = {
-    "default, a window": EpisodeConfig(sim=SimulationParams(distance_m=3.0, max_time_s=15.0),
+    "default, a window": fast_config(sim=SimulationParams(distance_m=3.0, max_time_s=15.0),
                                        window=TorqueFreeWindow(0.2, 0.35)),
     "paper, the plant's motor": load_gait("paper").override({"gait.motor_solve": "plant", "sim.distance_m": 1.5}),
 }
@@ -48,7 +49,7 @@ def test_the_work_by_role_is_the_applied_torques_work_regrouped_by_role(name):
 
 
 def test_the_work_by_role_is_in_the_record_and_an_older_record_reads_without_it(tmp_path):
-    r = run_episode(EpisodeConfig(sim=SimulationParams(distance_m=0.3, max_time_s=5.0)))
+    r = run_episode(fast_config(sim=SimulationParams(distance_m=0.3, max_time_s=5.0)))
     r.to_json(tmp_path / "result.json")
     data = json.loads((tmp_path / "result.json").read_text())
     assert set(data["work_by_role"]) == set(ROLES)

@@ -277,7 +277,7 @@ def episode_task(config: dict[str, Any], kick: dict[str, float] | None = None) -
     drake_biped.episode.Kick); its result dictionary plus worker bookkeeping."""
     from drake_biped.api_guard import drake_failures_raised
     from drake_biped.episode import Kick, run_episode
-    from drake_biped.params import config_of_record
+    from drake_biped.legacy import config_of_record
 
     t0 = time.perf_counter()
     with drake_failures_raised("episode on a Dask worker"):  # a SystemExit would end the worker, not the task

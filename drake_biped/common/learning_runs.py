@@ -45,6 +45,7 @@ from drake_biped.common.options import (
 from drake_biped.common.walks import REWALK_M, rewalk, window_of
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.learners.registry import DEFAULT_LEARNER, learner_class, learner_from_state
+from drake_biped.legacy import config_of_record
 from drake_biped.paper import (
     GARB_BETA,
     GARB_MEAN_S,
@@ -57,7 +58,6 @@ from drake_biped.params import (
     EpisodeConfig,
     ParameterError,
     TorqueFreeWindow,
-    config_of_record,
     parameter_info,
 )
 from drake_biped.records import read_json, write_atomic

@@ -285,9 +285,10 @@ def episode_config(args: argparse.Namespace) -> EpisodeConfig:
     config = with_clock(config, args.time_step, args.control_period)
     config = with_model(config, args.model)
     if args.time_step is not None and args.time_step > CONVERGED_TIME_STEP_S:  # accepted, but say what it means
-        print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, beyond the "
-              "steps at which the default gait's walk converges (docs/RESULTS.md, 'Physics with a continuous limit'); from 5 ms its "
-              "control loop diverges, which ends an episode as 'diverged'", file=sys.stderr)
+        print(f"warning: --time-step {args.time_step:g} is above {1e3 * CONVERGED_TIME_STEP_S:g} ms, coarser than "
+              "any shipped gait's step and than the steps at which their walks converge (docs/RESULTS.md, 'Physics "
+              "with a continuous limit', 'Its plant step, refined past 0.25 ms'); from 5 ms the control loop "
+              "diverges, which ends an episode as 'diverged'", file=sys.stderr)
     return config if args.seed is None else config.replace(seed=args.seed)
 
 
@@ -325,14 +326,14 @@ def policy_window(path: Path) -> tuple[float, float]:
 def default_window(config: EpisodeConfig, params: str | None = None) -> tuple[tuple[float, float], str]:
     """The window a command compares with none when none is given, and where it comes from: the gait's own
     where it carries one, else the one its gait file declares (`resources.gait_compare_window`; `params`: the
-    --params given, None for the default gait). ParameterError naming --params where the gait declares none:
+    --params given, None for the default, the paper's walker). ParameterError naming --params where the gait declares none:
     another gait's window is no comparison for it, so the command needs --t1 and --t2 (or --policy)."""
     from drake_biped.resources import gait_compare_window
 
     w = config.window
     if w.active:
         return (w.start_s, w.end_s), "the gait's own window (its window section)"
-    name = "default" if params is None else params
+    name = "paper" if params is None else params
     declared = gait_compare_window(name)
     if declared is None:
         raise ParameterError(f"--params {name}: the gait declares no window to compare with none (its own never "

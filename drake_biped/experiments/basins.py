@@ -34,7 +34,7 @@ from drake_biped.common.walks import (
     attractor_of_walk,
     condition_window,
 )
-from drake_biped.params import LEARNED_WINDOW_S, EpisodeConfig, ParameterError, check_settings
+from drake_biped.params import DEFAULT_WINDOW_S, EpisodeConfig, ParameterError, check_settings
 from drake_biped.records import write_record
 from drake_biped.versions import versions
 
@@ -49,7 +49,7 @@ class BasinSettings:
 
     config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 30.0,
                                                                                     "sim.max_time_s": 180.0}))
-    window: tuple[float, float] = LEARNED_WINDOW_S
+    window: tuple[float, float] = DEFAULT_WINDOW_S
     hip_angles_rad: tuple[float, ...] = (0.10, 0.13, 0.16)
     speeds_mps: tuple[float, ...] = (0.15, 0.175, 0.20)
     transient_m: float = TRANSIENT_M

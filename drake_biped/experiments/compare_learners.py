@@ -33,13 +33,13 @@ from drake_biped.common.options import (
     learner_names,
     print_lines,
 )
+from drake_biped.legacy import config_of_record
 from drake_biped.paper import GARB_MEAN_S, GARB_VARIANCE_S2
 from drake_biped.params import (
     EpisodeConfig,
     ParameterError,
     TorqueFreeWindow,
     check_settings,
-    config_of_record,
 )
 from drake_biped.records import read_json, write_record
 from drake_biped.versions import versions

@@ -8,11 +8,13 @@ if it scores at least as well as the parent (`--method cmaes`: CMA-ES over the s
 What a candidate scores: `objectives.OBJECTIVES`, one entry per objective with its scoring function and what it
 scores (`drake-biped gait-search --help` prints them).
 
-Which parameters mutate (MUTATION_SETS): "default" (MUTATIONS, the CPG's u_a, u_r, kappa among them), "paper"
+Which parameters mutate (MUTATION_SETS): "servo" (MUTATIONS, the CPG's u_a, u_r, kappa among them), "paper"
 (PAPER_MUTATIONS: the gains the paper does not print and the CPG phase the first swing starts from, the CPG and
 the printed initiation held at what the start configuration has), "near_paper" (those and the CPG's u_a, u_r,
 kappa), "coast" (MUTATIONS, the knee's hold torque, the torso's gains and the stance knee) or "paper_motor"
-(what the paper does not print when the hip is its ODE motor).
+(what the paper does not print when the hip is its ODE motor); unless told, the one that fits the gait's hip drive
+(`fitting_mutations`). The set a search record names "default" is "servo" (its name until the paper's walker
+became the default gait).
 Every generation is appended to `search.jsonl`; a rerun resumes from its last line (a damaged log is set aside
 as search.jsonl.broken and resumed from its last readable generation before the damage). The children of a
 generation are scored in parallel on Dask (`executor`).
@@ -42,11 +44,11 @@ from drake_biped.common.options import (
     number,
 )
 from drake_biped.experiments.objectives import ACCEPTANCE_WINDOWS, OBJECTIVES, POLICY_DRAWS, score
+from drake_biped.legacy import config_of_record
 from drake_biped.params import (
     EpisodeConfig,
     ParameterError,
     check_settings,
-    config_of_record,
 )
 from drake_biped.records import read_kept_lines, write_text_atomic
 from drake_biped.versions import versions
@@ -120,8 +122,9 @@ PAPER_MOTOR_MUTATIONS = {
        if k[1] not in ("hip_kp", "hip_kd", "placement_gain", "placement_velocity_gain", "swing_offset_rad")},
     ("gait", "knee_hold_torque"): ("add", 0.3, -2.0, 10.0),
 }
-MUTATION_SETS = {"default": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
+MUTATION_SETS = {"servo": MUTATIONS, "paper": PAPER_MUTATIONS, "near_paper": NEAR_PAPER_MUTATIONS,
                  "coast": COAST_MUTATIONS, "paper_motor": PAPER_MOTOR_MUTATIONS}
+
 
 def mutate(config: EpisodeConfig, rng: random.Random, sigma: float = 0.1, mutations=None) -> EpisodeConfig:
     """A child of `config`: every parameter in `mutations` (default MUTATIONS) moved by a random step
@@ -155,12 +158,14 @@ class GaitSearchSettings:
     seed: int = 0
     distance_m: float = 6.0
     windows: tuple[tuple[float, float], ...] = ACCEPTANCE_WINDOWS
-    mutations: str = "default"
+    mutations: str | None = None  # None: the set that fits the gait's hip drive (`fitting_mutations`)
     objective: str = "windows"
     policy_draws: int = POLICY_DRAWS
     force: bool = False  # more than MAX_CANDIDATES candidates
 
     def __post_init__(self) -> None:
+        if self.mutations is None:
+            object.__setattr__(self, "mutations", fitting_mutations(self.config))
         if self.mutations not in MUTATION_SETS:
             raise ParameterError(f"mutations {self.mutations!r} is not one of {sorted(MUTATION_SETS)}")
         if self.objective not in OBJECTIVES:
@@ -372,6 +377,8 @@ def _check_log(records: list[dict], settings: GaitSearchSettings, method: str, p
     wanted = {"objective": settings.objective, "mutations": settings.mutations, "sigma": settings.sigma,
               "seed": settings.seed, "policy_draws": settings.policy_draws, "method": method}
     recorded = {k: first.get(k, "es" if k == "method" else None) for k in wanted}
+    if recorded["mutations"] == "default":  # the servo's set, by its former name
+        recorded["mutations"] = "servo"
     differs = [f"{k} {recorded[k]!r} there, {wanted[k]!r} here" for k in wanted
                if recorded[k] is not None and recorded[k] != wanted[k]]
     if differs:
@@ -393,18 +400,25 @@ PARSER = dict(help="evolve gait parameters for walking and torque-free savings",
               epilog="objectives: " + "  ".join(f"'{name}': {o.about}" for name, o in OBJECTIVES.items()))
 
 
+
+def fitting_mutations(config: EpisodeConfig) -> str:
+    """The mutation set a search of `config` takes unless told: "paper_motor" under the hip motor (the paper's
+    walker: what the paper does not print, the servo's gains unread), "servo" under the servo."""
+    return "paper_motor" if config.gait.hip_drive == "motor" else "servo"
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped gait-search`'s options."""
     add_episode_options(p)
     p.add_argument("--generations", type=count, default=50, help="generations")
     p.add_argument("--offspring", type=count, default=4, help="children per generation")
     p.add_argument("--sigma", type=number("positive"), default=0.1, help="mutation scale")
-    p.add_argument("--mutations", choices=list(MUTATION_SETS), default="default",
-                   help="what mutates: 'default' (CPG u_a, u_r, kappa and the gains), 'paper' (only what "
+    p.add_argument("--mutations", choices=list(MUTATION_SETS), default=None,
+                   help="what mutates: 'servo' (CPG u_a, u_r, kappa and the servo's gains), 'paper' (only what "
                    "the paper does not print: the CPG and the initiation held), 'near_paper' (those "
-                   "and u_a, u_r, kappa), 'coast' (default, the knee's hold torque, the torso's "
+                   "and u_a, u_r, kappa), 'coast' (servo, the knee's hold torque, the torso's "
                    "gains and the stance knee) or 'paper_motor' (what the paper does not print when the hip is "
-                   "its ODE motor: the motor's limit, the knees, ankles, torso and touchdown phase)")
+                   "its ODE motor: the motor's limit, the knees, ankles, torso and touchdown phase); default: "
+                   "'paper_motor' for a gait driven by the hip motor (the paper's walker), 'servo' for a servo's")
     p.add_argument("--method", choices=["es", "cmaes"], default="es",
                    help="'es': the (1 + offspring) evolution strategy; 'cmaes': CMA-ES (pycma), "
                    "offspring candidates a generation")

@@ -368,12 +368,14 @@ PARSER = dict(help="grid search of CPG parameters and the initiation (Table IV),
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped grid`'s options."""
+    from drake_biped.resources import grid_spec_names
+
     add_episode_options(p)
     p.add_argument("--points-per-axis", type=count, default=None,
                    help="points per range (cell centres) of Table IV's five CPG parameters and the "
                    "initial hip angle (0-15.2 deg) and speed (0-0.35 m/s); default 2 (128 points)")
     p.add_argument("--spec", default=None, help="a YAML grid spec: axes: {name: {min, max, points} | "
-                   "{values: [...]}}, or a shipped one by name (around_default, slope_0.02, slope_2deg, tiny)")
+                   "{values: [...]}}, or a shipped one by name (" + ", ".join(grid_spec_names()) + ")")
     add_resumable_run_options(p)
 
 

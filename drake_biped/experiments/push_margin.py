@@ -36,7 +36,7 @@ from drake_biped.common.options import (
 from drake_biped.common.walks import CONDITIONS, condition_window, steady_step
 from drake_biped.paper import PUSH_DURATION_S
 from drake_biped.params import (
-    LEARNED_WINDOW_S,
+    DEFAULT_WINDOW_S,
     EpisodeConfig,
     ParameterError,
     Push,
@@ -57,7 +57,7 @@ class PushMarginSettings:
     """The gait, the torque-free period compared with none, the force grid, the phases and the timing."""
 
     config: EpisodeConfig = field(default_factory=lambda: EpisodeConfig().override({"sim.distance_m": 12.0}))
-    window: tuple[float, float] = LEARNED_WINDOW_S
+    window: tuple[float, float] = DEFAULT_WINDOW_S
     max_force_n: float = 100.0
     force_step_n: float = 5.0
     phases: int = 12

@@ -18,7 +18,7 @@ functions as its own command:
                      grid's best
     compare_learners/  GARB, CMA-ES and PGPE side by side against the window map's best window
 
-All of it on one gait, the paper's walker `paper` (the default) or `--gait default` (STORIES: the choices each
+All of it on one gait, the paper's walker `paper` (the default) or `--gait fast_servo`, our own faster gait (STORIES: the choices each
 gait's story makes beyond the paper's printed settings): "the learned window" is the best trial of `learn` (of
 `learn_variant` when the paper's settings learned none; the window map's cheapest when neither did). The other
 shipped gaits are named in the report's closing section, with why each exists. Then DIR/report.md and
@@ -46,9 +46,9 @@ from drake_biped.common.options import (
     add_resumable_run_options,
     cluster,
 )
+from drake_biped.legacy import config_of_record
 from drake_biped.paper import SLOPE_RAD
 from drake_biped.params import (
-    LEARNED_WINDOW_S,
     PAPER_CPG,
     EpisodeConfig,
     Ground,
@@ -56,18 +56,16 @@ from drake_biped.params import (
     ParameterError,
     TorqueFreeWindow,
     check_settings,
-    config_of_record,
 )
 from drake_biped.records import read_json, read_kept, write_atomic
-from drake_biped.resources import load_gait
+from drake_biped.resources import gait_compare_window, load_gait
 from drake_biped.versions import versions
 
 __all__ = ["DEFAULT_STORY", "FULL", "QUICK", "STORIES", "Profile", "ReproduceSettings", "Reproduction", "Story",
            "check_out", "run", "steps_of", "story_of"]
 
-LEVEL_WINDOW = LEARNED_WINDOW_S  # compared with none where no window was learned and none of the map walks
 SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record it
-# The 2.0 deg grid's changes to the default gait: Table VII's CPG parameters raised (the paper: +25 to +51 %)
+# The 2.0 deg grid's changes to the story's gait: Table VII's CPG parameters raised (the paper: +25 to +51 %)
 # and the torso leaned further forward (rad), with a larger placement gain.
 SLOPE_2DEG_CPG_SCALE = 1.25
 SLOPE_2DEG_LEANS = (0.0, 0.04, 0.08, 0.12)
@@ -81,8 +79,8 @@ class Story:
     gait's name), the start (t1, t2 in s) and variance of the exploration matched to it (`learn_variant`), and
     the span of t1 (s) its dynamics step sweeps, the learned t2 kept (None: the learned t1 +-
     T1_SWEEP_HALF_SPAN_S, ending before t2), and the second window its time-step study refines beside the
-    learned one. `why`: the reasons, for the report; `cost`: the wall time of its episodes against the default
-    gait's, for the time a run announces."""
+    learned one. `why`: the reasons, for the report; `cost`: the wall time of its episodes against
+    fast_servo's, for the time a run announces."""
 
     gait: str
     variant_start: tuple[float, float]
@@ -105,8 +103,8 @@ class Story:
 
 
 STORIES = {
-    "default": Story("default", (0.4, 0.4), 0.01, (0.30, 0.46),
-                     why="the default gait (0.42 s steps): the variant starts where its windows begin (0.4, 0.4 s) "
+    "fast_servo": Story("fast_servo", (0.4, 0.4), 0.01, (0.30, 0.46),
+                        why="our own faster gait (0.42 s steps): the variant starts where its windows begin (0.4, 0.4 s) "
                          "with a quarter of the paper's variance; t1 swept over 0.30-0.46 s around its learned 0.37 s"),
     "paper": Story("paper", (0.1, 0.2), 0.01,
                    why="the paper's walker (Table III's CPG, 0.90 s steps): its window map's cheapest window frees "
@@ -118,9 +116,8 @@ STORIES = {
 }
 
 
-# The story (its gait's name) a reproduction tells unless told: the paper's walker, whose full run ships
-# (drake_biped/results/full_run.json). Not params.DEFAULT_GAIT, the default gait's gains, which
-# EpisodeConfig() and the other commands walk.
+# The story (its gait's name) a reproduction tells unless told: the paper's walker, EpisodeConfig(), whose full
+# run ships (drake_biped/results/full_run.json).
 DEFAULT_STORY = "paper"
 
 
@@ -168,12 +165,12 @@ class Profile:
 
 # The quick run: the walk, the cheap verdicts (Table III walked 10 m, or falling in a few steps on the default
 # gait), the shipped full run's learned windows walked again, a few learning episodes and one Floquet orbit
-# (4.3 min on 2 workers on the paper's walker; its minutes below are the default gait's, Story.cost scales them).
+# (4.3 min on 2 workers on the paper's walker; its minutes below are fast_servo's, Story.cost scales them).
 # What it is too small to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
 QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 1.3, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
                 steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
-# The full run: about 117 min on 2 workers from scratch on the default gait (benchmarks/results/reproduce-full/,
+# The full run: about 117 min on 2 workers from scratch on fast_servo (benchmarks/results/reproduce-full/,
 # each step's summary.json; the paper's walker takes Story.cost times as long), its largest parts the learners'
 # comparison (25 min), GARB's two learning runs (18 and 14 min), the push margins (21 min) and the Table IV grid
 # (9 min).
@@ -194,7 +191,7 @@ class Reproduction:
     @property
     def _gait_title(self) -> str:
         """The gait as the time-step study's table names it (its own command's words)."""
-        return "Default gait" if self.story.gait == "default" else f"Gait {self.story.gait}"
+        return f"Gait {self.story.gait}"
 
     @property
     def base(self) -> EpisodeConfig:
@@ -213,7 +210,7 @@ class Reproduction:
     def learned_window(self) -> tuple[tuple[float, float], str, Path | None]:
         """The story gait's learned torque-free period (t1, t2), where it came from, and the learning record
         it came from: the best learned trial of `learn` (the paper's settings), else of `learn_variant`; else the
-        window map's cheapest, else LEVEL_WINDOW (no record)."""
+        window map's cheapest, else the window the gait's file declares (no record)."""
         from drake_biped.common.learning_record import best_learned_trial
 
         for source in ("learn", "learn_variant"):
@@ -228,7 +225,11 @@ class Reproduction:
         if best is not None:
             return (round(best["t1"], 4), round(best["t2"], 4)), "the window map's cheapest (no trial learned one)", \
                 None
-        return LEVEL_WINDOW, "no trial learned one and no window of the map walks", None
+        declared = gait_compare_window(self.story.gait)
+        if declared is None:
+            raise ParameterError(f"reproduce: no trial learned a window on {self.story.gait!r}, no window of its map "
+                                 "walks, and its gait file declares none (compare_window): nothing to compare")
+        return declared[0], f"no trial learned one and no window of the map walks: {declared[1]}", None
 
     def summary(self, step: str) -> dict[str, Any]:
         """A finished step's summary in this folder; empty when it has none."""
@@ -744,19 +745,20 @@ def run(settings: ReproduceSettings, out: Path, client=None, progress: bool = Tr
 
 def check_out(out: Path, profile: Profile, gait: str = DEFAULT_STORY) -> None:
     """Refuse an output folder that holds another profile's run, or a run on another gait (its records would
-    be reused for the wrong walker); a folder without a gait recorded holds the default gait's."""
+    be reused for the wrong walker); a folder without a gait recorded holds a run on `fast_servo`, the default
+    story when it was made."""
     marker = out / "profile.json"
     kept = read_kept(marker)
     if isinstance(kept, dict):
         saved = kept.get("name")
         if saved != profile.name:
             raise ParameterError(f"--out {out} holds a {saved!r} run; use another folder for a {profile.name!r} run")
-        saved_gait = kept.get("gait", "default")
+        saved_gait = kept.get("gait", "fast_servo")
         if saved_gait != gait:
             raise ParameterError(f"--out {out} holds a run on the {saved_gait!r} gait; use another folder for "
                                  f"--gait {gait}")
     out.mkdir(parents=True, exist_ok=True)
-    write_atomic(marker, profile.to_dict() | ({} if gait == "default" else {"gait": gait}))
+    write_atomic(marker, profile.to_dict() | {"gait": gait})
 
 
 COMMAND = "reproduce"
@@ -769,9 +771,10 @@ PARSER = dict(help="every experiment of the paper and one report beside its numb
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """`drake-biped reproduce`'s options."""
     p.add_argument("--quick", action="store_true", help="small settings: the same report in minutes")
-    p.add_argument("--gait", default=DEFAULT_STORY, choices=sorted(STORIES),
-                   help="whose story: `paper` (the default: Table III's CPG, the hip as ODE's motor), or `default` "
-                        "(the toolkit's default gait, 0.42 s steps)")
+    p.add_argument("--params", "--gait", dest="gait", default=DEFAULT_STORY, choices=sorted(STORIES),
+                   help="the shipped gait whose story to tell, as --params names it elsewhere (--gait is the same "
+                        "option): `paper` (the default: Table III's CPG, the hip as ODE's motor), or `fast_servo` "
+                        "(our own faster gait, 0.42 s steps)")
     add_resumable_run_options(p)
 
 

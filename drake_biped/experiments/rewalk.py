@@ -21,10 +21,10 @@ from drake_biped.common.options import (
     run_command,
 )
 from drake_biped.common.walks import rewalk
+from drake_biped.legacy import config_of_record
 from drake_biped.params import (
     ParameterError,
     check_settings,
-    config_of_record,
 )
 from drake_biped.records import read_json, write_record
 from drake_biped.versions import versions

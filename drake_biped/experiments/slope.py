@@ -53,7 +53,7 @@ from drake_biped.common.walks import changed, window_of
 from drake_biped.learners.garb import GarbLearner
 from drake_biped.paper import GARB_VARIANCE_S2, SLOPE_LEVEL_LENGTH_M, SLOPE_MOVING_AVERAGE, SLOPE_RAD
 from drake_biped.params import (
-    LEARNED_WINDOW_S,
+    DEFAULT_WINDOW_S,
     EpisodeConfig,
     Ground,
     ParameterError,
@@ -317,7 +317,7 @@ class SlopeSettings:
     slope_rad: float = SLOPE_RAD
     level_length_m: float = SLOPE_LEVEL_LENGTH_M
     policy: str | None = None
-    window: tuple[float, float] = LEARNED_WINDOW_S
+    window: tuple[float, float] = DEFAULT_WINDOW_S
     variance: float = GARB_VARIANCE_S2
     trials: int = 2
     episodes: int = 100

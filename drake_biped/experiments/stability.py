@@ -44,7 +44,7 @@ from drake_biped.common.options import (
 from drake_biped.common.walks import CONDITIONS, condition_window
 from drake_biped.paper import TABLE_VI
 from drake_biped.params import (
-    LEARNED_WINDOW_S,
+    DEFAULT_WINDOW_S,
     EpisodeConfig,
     InitialConditions,
     ParameterError,
@@ -67,7 +67,7 @@ MAX_BOOTSTRAP = 100_000  # bootstrap resamples of the return maps' eigenvalues  
 class StabilitySettings:
     """What a stability run depends on besides the episode configuration."""
 
-    window: tuple[float, float] = LEARNED_WINDOW_S
+    window: tuple[float, float] = DEFAULT_WINDOW_S
     trials: int = 8
     push_force_n: float = 20.0
     push_start_s: float = 0.4

@@ -32,12 +32,12 @@ from drake_biped.common.options import (
     print_lines,
     run_command,
 )
+from drake_biped.legacy import config_of_record
 from drake_biped.params import (
     EpisodeConfig,
     ParameterError,
     TorqueFreeWindow,
     check_settings,
-    config_of_record,
     walked_the_distance,
 )
 from drake_biped.records import read_kept_lines, write_text_atomic
