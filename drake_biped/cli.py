@@ -173,8 +173,23 @@ def _holding_the_out_folder(args: argparse.Namespace) -> Iterator[None]:
     from drake_biped.records import claim_folder
 
     with claim_folder(Path(out), args.command, _settings_of(args), overwrite=getattr(args, "overwrite", False),
-                      growable=getattr(args, "growable", ())):
+                      growable=getattr(args, "growable", ()), gait=_gait_of(args)):
         yield
+
+
+def _gait_of(args: argparse.Namespace) -> dict | None:
+    """The identity of the gait a command walks (`resources.gait_identity`): its --params (a reproduction's
+    --gait), else the paper's walker; None for a command that walks no gait of its options."""
+    from drake_biped.params import EpisodeConfig
+    from drake_biped.resources import gait_identity, load_gait
+
+    if args.command == "reproduce":
+        from drake_biped.experiments.reproduce import DEFAULT_STORY
+
+        return gait_identity(load_gait(getattr(args, "gait", None) or DEFAULT_STORY))
+    if not hasattr(args, "params"):
+        return None
+    return gait_identity(EpisodeConfig() if args.params is None else load_gait(args.params))
 
 
 DEBUG_ENV = "DRAKE_BIPED_DEBUG"

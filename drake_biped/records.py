@@ -176,9 +176,12 @@ LOCK_FILE = ".drake-biped.lock"
 
 @contextmanager
 def claim_folder(out: Path, command: str, settings: dict[str, Any], overwrite: bool = False,
-                 option: str = "--out", growable: tuple[str, ...] = ()) -> Iterator[None]:
+                 option: str = "--out", growable: tuple[str, ...] = (),
+                 gait: dict[str, Any] | None = None) -> Iterator[None]:
     """Hold the output folder `out` for one run of `command` with `settings` (a JSON-able mapping) while the
-    block runs.
+    block runs. `gait`: the identity of the gait the run walks (`resources.gait_identity`), recorded in RUN_FILE;
+    a folder whose run walked another gait (another SHA-256: a parameter file edited between runs) is another
+    run's.
 
     One process at a time: a second run into a folder held by another is refused, naming the holder. A folder
     holding another run's records (RUN_FILE names another command or other settings) is refused, naming both,
@@ -215,7 +218,7 @@ def claim_folder(out: Path, command: str, settings: dict[str, Any], overwrite: b
         lock.write(f"process {os.getpid()}: drake-biped {command}\n")
         lock.flush()
         header = out / RUN_FILE
-        this = {"command": command, "settings": settings}
+        this = {"command": command, "settings": settings, "gait": gait}
         before = _read_run_file(header)
         present = _listing(out)
         new_claim = before is None
@@ -353,6 +356,8 @@ def _write_run_file(out: Path, this: dict[str, Any], others: set[str] | None, wr
     folder: left in place when the run is killed, so that its resume counts what appeared since as the run's."""
     record: dict[str, Any] = {"command": this["command"],
                               "settings": json.loads(json.dumps(this["settings"], sort_keys=True))}
+    if this.get("gait"):
+        record["gait"] = this["gait"]
     if others is not None:
         present = _listing(out)
         if writing:
@@ -374,11 +379,19 @@ def _delete_listed(out: Path, files: set[str]) -> None:
             pass
 
 
+def _other_gait(before: dict[str, Any], this: dict[str, Any]) -> bool:
+    """Whether both runs record the gait they walk and it differs (a record older than the gait's is not asked)."""
+    old, new = before.get("gait"), this.get("gait")
+    return isinstance(old, dict) and isinstance(new, dict) and old.get("sha256") != new.get("sha256")
+
+
 def _same_run(before: Any, this: dict[str, Any], growable: tuple[str, ...]) -> bool:
     """Whether `this` run continues `before`: the same command and settings, `growable` counts aside."""
     if not isinstance(before, dict) or not isinstance(before.get("settings"), dict):
         return False
     drop = set(growable)
+    if _other_gait(before, this):
+        return False
     return before.get("command") == this["command"] and \
         {k: v for k, v in before["settings"].items() if k not in drop} == \
         {k: v for k, v in this["settings"].items() if k not in drop}
@@ -401,6 +414,12 @@ def _difference(before: Any, this: dict[str, Any]) -> str:
         return "an unreadable run record"
     if before.get("command") != this["command"]:
         return f"drake-biped {before.get('command')}; this run is drake-biped {this['command']}"
+    if _other_gait(before, this):
+        def named(gait):
+            return f"{gait.get('name') or 'another gait'} (sha256 {str(gait.get('sha256'))[:12]})"
+
+        return f"drake-biped {this['command']} on another gait: {named(before['gait'])} there, " \
+            f"{named(this['gait'])} here"
     old, new = before["settings"], this["settings"]
     changed = [f"--{k.replace('_', '-')} {old.get(k)!r} there, {new.get(k)!r} here"
                for k in sorted(set(old) | set(new)) if old.get(k) != new.get(k)]

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from drake_biped.cli import main
+from drake_biped.common.options import gait_line
 from drake_biped.params import EpisodeConfig, ParameterError
 from drake_biped.resources import gait_identity
 
@@ -668,7 +669,7 @@ def test_window_map_prints_c_mt_to_four_significant_digits_and_what_it_wrote(tmp
     monkeypatch.setattr(window_map, "run", lambda settings, out, client: record)
     assert main(["window-map", "--out", str(tmp_path / "wm")]) == 0
     out, err = capsys.readouterr()
-    assert out.splitlines() == ["no window: walked=True C_mt=0.2246", "1/1 windows walk 10 m",
+    assert out.splitlines() == [gait_line(EpisodeConfig()), "no window: walked=True C_mt=0.2246", "1/1 windows walk 10 m",
                                 "lowest C_mt: window (0.2, 0.5) C_mt=0.1235 (C_mt change -45.0 % vs no window)",
                                 f"wrote {tmp_path / 'wm'}/window_map.json, window_map.csv, window_map.png"]
     assert err == ""

@@ -97,6 +97,28 @@ def test_walk_into_another_walks_folder_is_refused_before_any_work(tmp_path, cap
     assert not (out / "trajectory.npz").exists()
 
 
+def test_a_folder_keeps_the_gait_it_walked_and_a_parameter_file_edited_since_is_another_run(tmp_path, capsys):
+    """The run record names the gait (its shipped name or None, and its SHA-256); the same command with a
+    parameter file whose gains changed since is another run's, refused before any work, naming both gaits."""
+    from drake_biped.resources import gait_identity, load_gait
+
+    params, out = tmp_path / "mine.json", tmp_path / "w"
+    params.write_text(json.dumps({"gait": {"torso_kd": 15.0}}))
+    argv = ["walk", "--params", str(params), "--distance", "0.1", "--no-animation", "--out", str(out)]
+    assert main(argv) == 0
+    recorded = json.loads((out / RUN_FILE).read_text())["gait"]
+    assert recorded == gait_identity(load_gait(params)) and recorded["name"] is None
+    assert capsys.readouterr().out.startswith(f"gait: another gait (sha256 {recorded['sha256'][:12]}), plant step")
+    params.write_text(json.dumps({"gait": {"torso_kd": 16.0}}))
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert e.value.code == 2 and len(err) == 1, err
+    assert f"on another gait: another gait (sha256 {recorded['sha256'][:12]}) there" in err[0]
+    main(["walk", "--distance", "0.1", "--no-animation", "--out", str(tmp_path / "p")])
+    assert json.loads((tmp_path / "p" / RUN_FILE).read_text())["gait"]["name"] == "paper"
+
+
 def test_a_window_map_beyond_its_limit_is_refused_before_any_work(tmp_path, capsys):
     from drake_biped.experiments.window_map import MAX_WINDOWS, WindowMapSettings
 

@@ -156,16 +156,18 @@ def test_the_window_compared_is_the_walked_gaits_and_named_or_the_command_asks_f
     for command in ("stability", "push-margin"):
         paper = settings(command, "--params", "paper")
         assert paper.window == (0.1, 0.2) and "window map" in paper.window_source
-        assert capsys.readouterr().out.startswith("window 0.1-0.2 s: the cheapest window of this gait's window map")
+        gait, window = capsys.readouterr().out.splitlines()
+        assert gait.startswith("gait: paper (sha256 ")  # every command that walks a gait names it first
+        assert window.startswith("window 0.1-0.2 s: the cheapest window of this gait's window map")
         assert settings(command).window == DEFAULT_WINDOW_S == (0.1, 0.2)  # no --params: the paper's walker's
-        assert capsys.readouterr().out.rstrip().endswith("(gait file paper)")
+        assert capsys.readouterr().out.rstrip().endswith("(gait file paper)")  # no --params: the paper's walker
         fast = settings(command, "--params", "fast_servo")
         assert fast.window == gait_compare_window("fast_servo")[0] == (0.3672, 0.8629)
         assert "learned" in capsys.readouterr().out
         with pytest.raises(ParameterError, match="--params paper_servo: the gait declares no window.*--t1 and --t2"):
             settings(command, "--params", "paper_servo")
         assert settings(command, "--params", "paper_servo", "--t1", "0.2", "--t2", "0.3").window == (0.2, 0.3)
-        assert capsys.readouterr().out == "window 0.2-0.3 s: --t1/--t2\n"
+        assert capsys.readouterr().out.splitlines()[-1] == "window 0.2-0.3 s: --t1/--t2"
     # the key is no parameter of the walk: the file still reads as a configuration
     assert EpisodeConfig.from_dict(json.loads(gait_path("paper").read_text())).window.active is False
     bad = tmp_path / "bad.json"

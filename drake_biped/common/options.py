@@ -20,7 +20,7 @@ from drake_biped.params import (
     check_window_given,
     with_time_step,
 )
-from drake_biped.resources import gait_names, load_gait
+from drake_biped.resources import gait_identity, gait_names, gait_text, load_gait
 
 # The sizes a run may be given, bounded before any work (`check_size`, `check_memory`). A run beyond a count
 # limit is refused unless forced (--force, force=True); one whose memory estimate exceeds half this machine's
@@ -289,7 +289,15 @@ def episode_config(args: argparse.Namespace) -> EpisodeConfig:
               "any shipped gait's step and than the steps at which their walks converge (docs/RESULTS.md, 'Physics "
               "with a continuous limit', 'Its plant step, refined past 0.25 ms'); from 5 ms the control loop "
               "diverges, which ends an episode as 'diverged'", file=sys.stderr)
-    return config if args.seed is None else config.replace(seed=args.seed)
+    config = config if args.seed is None else config.replace(seed=args.seed)
+    print(gait_line(config))
+    return config
+
+
+def gait_line(config: EpisodeConfig) -> str:
+    """The line every command that walks a gait prints before its work: which gait (its shipped name, or
+    "another gait", and the SHA-256 of its CPG, gains and initiation) at which plant step."""
+    return f"gait: {gait_text(gait_identity(config))}, plant step {1e3 * config.sim.time_step_s:g} ms"
 
 
 @contextmanager

@@ -36,7 +36,6 @@ from drake_biped.params import (
     walked_the_distance,
 )
 from drake_biped.records import warn, write_text_atomic
-from drake_biped.resources import gait_text
 
 
 class GraphvizMissingError(RuntimeError):
@@ -166,8 +165,8 @@ def run(settings: WalkSettings, out: Path, client=None, progress: bool = True):
 
 
 def summary_lines(result) -> list[str]:
-    """What `drake-biped walk` prints: which gait walked (its name and digest) at which plant step, how the walk
-    ended, its steps, its energy, its speed of simulation."""
+    """What `drake-biped walk` prints after its walk (the gait and the plant step are named before it,
+    `options.gait_line`): how the walk ended, its steps, its energy, its speed of simulation."""
     status = ((f"DIVERGED ({result.fall_reason})" if result.termination == "diverged" else f"FELL ({result.fall_reason})")
               if result.fell else f"ended: {result.termination}")
     cmt, cmt_kg = format_cost(result.cost_of_transport), format_cost(result.cost_of_transport_per_kg)
@@ -175,9 +174,7 @@ def summary_lines(result) -> list[str]:
         gait = "too few for a step period and length (3 touchdowns needed)"
     else:
         gait = f"step {result.step_period_s:.3f} s / {result.step_length_m:.3f} m"
-    walked = result.config.get("sim", {}) if isinstance(result.config, dict) else {}
     return [
-        f"gait: {gait_text(result.gait)}, plant step {1e3 * walked.get('time_step_s', float('nan')):g} ms",
         f"{status}: {result.distance_m:.2f} m in {result.duration_s:.2f} s ({result.mean_speed_mps:.3f} m/s), "
         f"{len(result.steps)} steps, {gait}",
         f"positive work {result.total_positive_work_j:.1f} J, C_mt {cmt} (E+/(m g d)), "
