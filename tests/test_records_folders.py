@@ -163,7 +163,7 @@ def test_a_failed_run_that_wrote_records_keeps_its_claim(tmp_path):
         assert (out / "trials" / "trial_0.json").exists()
 
 
-@pytest.mark.parametrize("folder", ["learn-default-seed1", "gait-search-hold-long"])
+@pytest.mark.parametrize("folder", ["learn-default-seed1", "time-step-study-learned"])
 def test_the_committed_records_from_before_the_lists_still_resume(tmp_path, folder):
     """A run file with no list of files (written by an older drake-biped): the same run resumes and the run file
     stays as it was; another run's --overwrite is refused naming the files, since none can be shown to be the
