@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis import floquet as fq
-from drake_biped.params import clock_of_record
+from drake_biped.legacy import clock_of_record
 
 
 def _fmt(value: float | None, spec: str = ".4g") -> str:

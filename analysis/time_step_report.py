@@ -12,7 +12,8 @@ from pathlib import Path
 from drake_biped.analysis.cost_of_transport import format_cost, format_cost_interval
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
 from drake_biped.analysis.series import signed_percent
-from drake_biped.params import SimulationParams, clock_of_record
+from drake_biped.legacy import clock_of_record
+from drake_biped.params import SimulationParams
 from drake_biped.records import save_figure
 
 

@@ -14,9 +14,9 @@ import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
-from drake_biped.params import DRAKE_DEFAULT_CONTACT, EpisodeConfig
+from drake_biped.params import DRAKE_DEFAULT_CONTACT, EpisodeConfig, SimulationParams
 
-__all__ = ["RECORD_BASE", "config_of_record"]
+__all__ = ["RECORD_BASE", "clock_of_record", "config_of_record"]
 
 # The sections a record's missing fields are read from (frozen: a record's walk must not move when a default does).
 RECORD_BASE = EpisodeConfig.from_dict({
@@ -92,3 +92,14 @@ def config_of_record(data: Any, where: str | None = None) -> EpisodeConfig:
             config.sim.control_period_s == config.sim.time_step_s:
         config = config.replace(sim=dataclasses.replace(config.sim, control_period_s=None))
     return config
+
+
+def clock_of_record(sim: Mapping[str, Any]) -> tuple[str, float]:
+    """The controller's clock (reading, update period in s) of a record's "sim" section. A record written before
+    the clock was part of the model names a control period: the fixed-rate loop it ran on."""
+    if "controller_clock" in sim:
+        return sim["controller_clock"], float(sim["update_period_s"])
+    period = sim.get("control_period_s")
+    if period is None:
+        return SimulationParams.PLANT_STEP_CLOCK, float(sim["time_step_s"])
+    return SimulationParams.FIXED_RATE_CLOCK, float(period)

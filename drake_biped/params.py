@@ -7,24 +7,25 @@ SI units throughout; angles in radians (degrees appear only at the command-line 
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from drake_biped.declared import ParameterError, Validated, _shown, check_declared, param, parameter_info
 from drake_biped.paper import (
     INITIAL_HIP_ANGLE_RAD,
     INITIAL_SPEED_MPS,
     TABLE_I_TOTAL_MASS_KG,
     TABLE_III,
 )
+from drake_biped.robot_model import RobotModel
 
 __all__ = [
     "ContactParams", "CpgParams", "param", "parameter_info", "EpisodeConfig", "GaitParams", "Ground", "InitialConditions", "ParameterError", "Push",
     "SHORT_NAMES", "SimulationParams", "DRAKE_DEFAULT_CONTACT",
-    "with_time_step", "clock_of_record", "clock_text", "walked_the_distance", "check_settings", "check_declared",
+    "with_time_step", "walked_the_distance", "check_settings", "check_declared",
     "check_given", "check_window_given", "config_of_params", "TorqueFreeWindow", "DEFAULT_CPG", "DEFAULT_GAIT", "PAPER_CPG",
     "DEFAULT_INITIAL", "DEFAULT_SIM", "DEFAULT_WINDOW_S", "RobotModel",
 ]
@@ -41,152 +42,8 @@ CONTACT_RADIUS_M = 0.01
 GRAVITY_MPS2 = 9.81
 
 
-class ParameterError(ValueError):
-    """A parameter is unknown, non-finite or out of its range. The message names it."""
-
-
-def _check_finite(owner: str, name: str, value: float) -> None:
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
-        raise ParameterError(f"{owner}.{name} must be a finite number, got {value!r}")
-
-
-def _check_range(owner: str, name: str, value: float, lo: float | None, hi: float | None) -> None:
-    _check_finite(owner, name, value)
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        lo_s = "-inf" if lo is None else f"{lo:g}"
-        hi_s = "inf" if hi is None else f"{hi:g}"
-        raise ParameterError(f"{owner}.{name} = {value!r} is outside [{lo_s}, {hi_s}]")
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def param(default: Any, unit: str, doc: str, lo: float | None = None, hi: float | None = None) -> Any:
-    """A parameter declared once: its default, its unit ("1" for a pure number, "" for a choice or a flag),
-    what it means and its bounds (None: unbounded on that side), as Drake's named vectors declare theirs. The
-    dataclass checks the bounds; the controller's Context parameter (control_law.LAW) and docs/PARAMETERS.md
-    read the unit and the text from here."""
-    return field(default=default, metadata={"unit": unit, "doc": doc, "bounds": (lo, hi)})
-
-
-def parameter_info(cls: type, name: str) -> dict[str, Any]:
-    """The declaration of `cls`'s field `name` (`param`): its unit, doc and bounds."""
-    for f in fields(cls):
-        if f.name == name:
-            if "doc" not in f.metadata:
-                raise KeyError(f"{cls.__name__}.{name} is not declared with param()")
-            return dict(f.metadata)
-    raise KeyError(f"{cls.__name__} has no field {name!r}")
-
-
-def _declared_value(owner: str, f: dataclasses.Field, value: Any) -> Any:
-    """`value` checked against the field `f`'s declaration (its type, and `param`'s bounds or finiteness; an int
-    given for a float comes back a float); ParameterError naming `owner`.`f.name` and the value otherwise."""
-    kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
-    optional = kind.endswith("| None")
-    kind = kind.removesuffix("| None").strip()
-    if value is None and optional:
-        return value
-    if kind == "float":
-        if not _is_number(value):
-            raise ParameterError(f"{owner}.{f.name} must be a number, got {_shown(value)}")
-        value = float(value)
-    elif kind == "int":
-        if not isinstance(value, int) or isinstance(value, bool):
-            raise ParameterError(f"{owner}.{f.name} must be an integer, got {_shown(value)}")
-    elif kind == "str":
-        if not isinstance(value, str):
-            raise ParameterError(f"{owner}.{f.name} must be a string, got {_shown(value)}")
-    elif kind in _SECTION_CLASSES and not isinstance(value, _SECTION_CLASSES[kind]):
-        hint = f"; build it with {kind}(...) or {kind}.from_dict(...)" if isinstance(value, dict) else ""
-        raise ParameterError(f"{owner}.{f.name} must be a {kind}, got {type(value).__name__} {_shown(value)}{hint}")
-    bounds = f.metadata.get("bounds")
-    if bounds is not None and _is_number(value):
-        _check_range(owner, f.name, value, *bounds)
-    elif isinstance(value, float):
-        _check_finite(owner, f.name, value)
-    return value
-
-
-def _shown(value: Any) -> str:
-    """`value` for a one-line message: its repr, cut to 60 characters."""
-    text = " ".join(repr(value).split())
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def check_declared(cls: type, name: str, value: Any, where: str) -> Any:
-    """`value` checked against the declaration of `cls`'s field `name` (`param`: its type and bounds), for a
-    value that enters elsewhere than through the dataclass (a function's argument); ParameterError naming
-    `where` otherwise. Returns the value (an int given for a float as a float)."""
-    for f in fields(cls):
-        if f.name == name:
-            try:
-                return _declared_value(cls.__name__, f, value)
-            except ParameterError as exc:
-                raise ParameterError(f"{where}: {exc}") from None
-    raise KeyError(f"{cls.__name__} has no field {name!r}")
-
-
-class _Validated:
-    """Mixin: every field is checked against its declared type after init (an int given for a float is
-    stored as a float), and every number against its declared bounds (`param`) or for being finite."""
-
-    def __post_init__(self) -> None:
-        owner = type(self).__name__
-        for f in fields(self):
-            value = _declared_value(owner, f, getattr(self, f.name))
-            if value is not getattr(self, f.name):
-                object.__setattr__(self, f.name, value)
-
-    def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any] | None, where: str | None = None, base: Any = None):
-        """An instance from a mapping of its fields (a JSON object); ParameterError naming `where` (default:
-        the class) for anything else, an unknown field or a bad value. An EpisodeConfig's sections take their
-        missing fields from `base` (an EpisodeConfig; default `EpisodeConfig()`, the paper's walker)."""
-        where = where or cls.__name__
-        if data is None:
-            data = {}
-        if not isinstance(data, Mapping):
-            shown = repr(data) if len(repr(data)) <= 60 else repr(data)[:57] + "..."
-            raise ParameterError(f"{where}: expected a mapping of {cls.__name__} fields, got {type(data).__name__} "
-                                 f"{shown}")
-        data = dict(data)
-        if cls is EpisodeConfig:
-            data.pop("about", None)  # a shipped gait file's reasons (drake_biped/gaits/): text, not a parameter
-            data.pop("compare_window", None)  # the window a gait file is compared with (resources.gait_compare_window)
-        known = {f.name: f for f in fields(cls)}
-        unknown = sorted(set(data) - set(known))
-        if unknown:
-            raise ParameterError(f"{where}: unknown parameter(s) {unknown}; known: {sorted(known)}")
-        kwargs = {}
-        defaults = (base if base is not None else cls()) if cls is EpisodeConfig else None
-        for name, value in data.items():
-            sub = _SECTIONS.get(name) if cls is EpisodeConfig else None
-            if sub is not None:
-                inner = f"{where}.{name}" if where == cls.__name__ else f"{where}, section {name!r}"
-                # a section's missing fields are the base configuration's (the paper's walker's unless a
-                # record's reader gives its own), so that {"gait": {"torso_kd": 12}} is that gait with one gain
-                # changed
-                default = getattr(defaults, name)
-                if default is not None and isinstance(value, Mapping):
-                    value = {**default.to_dict(), **value}
-                kwargs[name] = None if value is None else sub.from_dict(value, inner)
-            else:
-                kwargs[name] = value
-        try:
-            return cls(**kwargs)
-        except ParameterError as exc:
-            if where == cls.__name__:
-                raise
-            raise ParameterError(f"{where}: {exc}") from None
-
-
 @dataclass(frozen=True)
-class CpgParams(_Validated):
+class CpgParams(Validated):
     """The CPG of eq. 2-3 with Table III's symbols; its defaults are Table III as printed (`paper.TABLE_III`).
 
     Phase: d(gamma)/dt = u_r + kappa * (stance ankle angular velocity).
@@ -212,7 +69,7 @@ PAPER_CPG = CpgParams(**TABLE_III)  # Table III as printed.
 
 
 @dataclass(frozen=True)
-class GaitParams(_Validated):
+class GaitParams(Validated):
     """Gains and thresholds of the hip servo, torso balance, knees, ankles and touchdown detection.
 
     The defaults are the paper's walker's (drake_biped/gaits/paper.json, `--params paper`): the paper prints none
@@ -389,7 +246,7 @@ class GaitParams(_Validated):
 
 
 @dataclass(frozen=True)
-class InitialConditions(_Validated):
+class InitialConditions(Validated):
     """The paper's initiation: the thighs spread by hip_angle_rad (split evenly about an upright torso),
     all bodies moving forward at speed_mps. Both feet start on the ground; the front leg is the first
     stance leg. (Read as each thigh at +-7.6 deg, the body could not vault over the front foot at
@@ -405,7 +262,7 @@ class InitialConditions(_Validated):
 
 
 @dataclass(frozen=True)
-class TorqueFreeWindow(_Validated):
+class TorqueFreeWindow(Validated):
     """Swing-hip torque is exactly zero from start_s to end_s after each step start T_n.
 
     end_s <= start_s means no window (the paper's convention t2 <= t1)."""
@@ -428,7 +285,7 @@ class TorqueFreeWindow(_Validated):
 
 
 @dataclass(frozen=True)
-class Push(_Validated):
+class Push(Validated):
     """A horizontal force on the torso (N, + forward) from start_s for duration_s."""
 
     force_n: float = param(0.0, "N", "the push's horizontal force on the torso (+ forward)", -1000.0, 1000.0)
@@ -437,7 +294,7 @@ class Push(_Validated):
 
 
 @dataclass(frozen=True)
-class Ground(_Validated):
+class Ground(Validated):
     """Ground: level (slope 0), tilted everywhere, or level up to level_length_m then tilted.
 
     slope_rad > 0 ascends in +x. A piecewise ground (level_length_m set) must ascend."""
@@ -474,7 +331,7 @@ class Ground(_Validated):
 
 
 @dataclass(frozen=True)
-class SimulationParams(_Validated):
+class SimulationParams(Validated):
     """Plant time step, the controller's clock and episode limits.
 
     The controller's clock is part of the model. `control_period_s` None (the default) is the paper's reading:
@@ -538,7 +395,7 @@ class SimulationParams(_Validated):
 
 
 @dataclass(frozen=True)
-class ContactParams(_Validated):
+class ContactParams(Validated):
     """The contact between the feet and the ground: compliant point contact, its physical parameters explicit.
 
     Each of the four foot spheres and the ground carries the same material (the model file's own values for
@@ -590,92 +447,8 @@ def with_time_step(sim: SimulationParams, time_step_s: float, option: str = "tim
     return dataclasses.replace(sim, time_step_s=time_step_s)
 
 
-def clock_of_record(sim: Mapping[str, Any]) -> tuple[str, float]:
-    """The controller's clock (reading, update period in s) of a record's "sim" section. A record written before
-    the clock was part of the model names a control period: the fixed-rate loop it ran on."""
-    if "controller_clock" in sim:
-        return sim["controller_clock"], float(sim["update_period_s"])
-    period = sim.get("control_period_s")
-    if period is None:
-        return SimulationParams.PLANT_STEP_CLOCK, float(sim["time_step_s"])
-    return SimulationParams.FIXED_RATE_CLOCK, float(period)
-
-
-def clock_text(sim: Mapping[str, Any]) -> str:
-    """The clock of a record's "sim" section in words, for reports."""
-    reading, period = clock_of_record(sim)
-    if reading == SimulationParams.PLANT_STEP_CLOCK:
-        return f"the controller acts at every plant step ({1e3 * period:g} ms), the paper's reading"
-    return f"the controller a fixed-rate loop of {1e3 * period:g} ms ({1.0 / period:g} Hz)"
-
-
-MODEL_FORMATS = {".urdf": "urdf", ".sdf": "sdf"}
-
-
 @dataclass(frozen=True)
-class RobotModel:
-    """A robot model file given by the user (URDF or SDFormat), carried by its content: an episode on a Dask
-    worker on another machine parses the same text, and a record names the file and its SHA-256.
-
-    `package_xml`: the package.xml beside the file when there was one (its packages resolve the file's
-    package:// URIs on the machine where it is found; the shipped `drake_biped` package always resolves).
-    As a record (`to_dict`) it is {"name", "sha256", "format", "package_xml", "text"}; `from_dict` checks the
-    text against the SHA-256."""
-
-    name: str
-    text: str
-    format: str = "urdf"
-    sha256: str = ""
-    package_xml: str | None = None
-    # The folder the file was read from: its relative file names (meshes) resolve against it.
-    directory: str | None = None
-
-    def __post_init__(self) -> None:
-        if self.format not in MODEL_FORMATS.values():
-            raise ParameterError(f"model {self.name!r}: format {self.format!r} is not one of "
-                                 f"{sorted(MODEL_FORMATS.values())}")
-        digest = hashlib.sha256(self.text.encode()).hexdigest()
-        if self.sha256 and self.sha256 != digest:
-            raise ParameterError(f"model {self.name!r}: its text's SHA-256 is {digest}, not the recorded "
-                                 f"{self.sha256}")
-        object.__setattr__(self, "sha256", digest)
-
-    @classmethod
-    def from_file(cls, path: str | Path, option: str = "--model") -> RobotModel:
-        """The model in `path`; ParameterError naming `option` and the path when it is missing, unreadable or
-        of another kind than .urdf or .sdf."""
-        path = Path(path)
-        kind = MODEL_FORMATS.get(path.suffix.lower())
-        if kind is None:
-            raise ParameterError(f"{option} {str(path)!r}: not a .urdf or .sdf file")
-        if not path.is_file():
-            raise ParameterError(f"{option} {str(path)!r}: no such file")
-        try:
-            text = path.read_text()
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ParameterError(f"{option} {str(path)!r}: cannot be read ({exc})") from None
-        beside = path.resolve().parent / "package.xml"
-        return cls(path.name, text, kind, package_xml=str(beside) if beside.is_file() else None,
-                   directory=str(path.resolve().parent))
-
-    @classmethod
-    def from_dict(cls, data: Any, where: str = "model") -> RobotModel:
-        if not isinstance(data, Mapping) or not isinstance(data.get("text"), str) or \
-                not isinstance(data.get("name"), str):
-            raise ParameterError(f"{where}: expected a model file's path or a record with its name and text, "
-                                 f"got {type(data).__name__}")
-        unknown = sorted(set(data) - {f.name for f in fields(cls)})
-        if unknown:
-            raise ParameterError(f"{where}: unknown field(s) {unknown}")
-        return cls(**data)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "sha256": self.sha256, "format": self.format, "package_xml": self.package_xml,
-                "directory": self.directory, "text": self.text}
-
-
-@dataclass(frozen=True)
-class EpisodeConfig(_Validated):
+class EpisodeConfig(Validated):
     """Everything one episode depends on. `EpisodeConfig()` is the paper's walker at its shipped step
     (drake_biped/gaits/paper.json: Table III's CPG, the paper's initiation, the hip as ODE's motor); our own faster
     gait is `resources.load_gait("fast_servo")`."""
@@ -737,6 +510,17 @@ class EpisodeConfig(_Validated):
     def replace(self, **changes: Any) -> EpisodeConfig:
         """A copy with whole sections (or the seed) replaced: `config.replace(window=TorqueFreeWindow(0.2, 0.5))`."""
         return dataclasses.replace(self, **changes)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any] | None, where: str | None = None,
+                  base: EpisodeConfig | None = None) -> EpisodeConfig:
+        """A configuration from a mapping of its sections (a parameter file, a record's "config"); each
+        section's missing fields are `base`'s (default `EpisodeConfig()`, the paper's walker; a record's reader
+        gives its own), so that {"gait": {"torso_kd": 12}} is that gait with one gain changed. A gait file's
+        "about" and "compare_window" are text and the window it is compared with, not parameters."""
+        if isinstance(data, Mapping):
+            data = {k: v for k, v in data.items() if k not in ("about", "compare_window")}
+        return super().from_dict(data, where, base if base is not None else cls())
 
     def override(self, values: Mapping[str, Any], sampled: bool = False) -> EpisodeConfig:
         """A copy with single fields changed, named `section.field` (`"cpg.u_a"`, `"gait.torso_pitch_rad"`,
@@ -862,7 +646,6 @@ _SECTIONS: dict[str, type] = {
     "sim": SimulationParams,
     "contact": ContactParams,
 }
-_SECTION_CLASSES = {cls.__name__: cls for cls in _SECTIONS.values()}
 
 # Short names of single fields: the symbols of Tables III-IV, the initiation and the torque-free window.
 SHORT_NAMES = {

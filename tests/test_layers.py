@@ -9,6 +9,8 @@ from pathlib import Path
 PURE, CORE, RECORDS, EXPERIMENTS, CLI = 0, 1, 2, 3, 4
 LAYERS = {
     "drake_biped.paper": PURE,
+    "drake_biped.declared": PURE,
+    "drake_biped.robot_model": PURE,
     "drake_biped.analysis.cost_of_transport": PURE,
     "drake_biped.analysis.reward": PURE,
     "drake_biped.analysis.return_map": PURE,

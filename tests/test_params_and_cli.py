@@ -126,7 +126,8 @@ def test_the_controller_clock_is_the_plant_step_by_default_and_every_record_name
     an older record's control period is the fixed-rate loop it ran on."""
     from drake_biped.control_law import L_DT
     from drake_biped.controller import law_vector
-    from drake_biped.params import clock_of_record, with_time_step
+    from drake_biped.legacy import clock_of_record
+    from drake_biped.params import with_time_step
 
     config = EpisodeConfig().override({"sim.time_step_s": 2.5e-4})
     assert config.sim.clock == "plant step" and config.sim.update_period_s == 2.5e-4

@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 import drake_biped as db
 from drake_biped import params
 from drake_biped.cli import main
+from drake_biped.declared import Validated
 from drake_biped.legacy import config_of_record
 from drake_biped.params import EpisodeConfig, GaitParams, ParameterError, TorqueFreeWindow
 from drake_biped.resources import gait_names, gait_path, load_gait
@@ -35,7 +36,7 @@ def _sections() -> dict[str, type]:
     for f in fields(EpisodeConfig):
         name = str(f.type).removesuffix("| None").strip()
         cls = getattr(params, name, None)
-        if isinstance(cls, type) and issubclass(cls, params._Validated):
+        if isinstance(cls, type) and issubclass(cls, Validated):
             out[f.name] = cls
     return out
 

@@ -40,6 +40,7 @@ from drake_biped.common.options import (
     with_clock,
     with_model,
 )
+from drake_biped.legacy import clock_of_record
 from drake_biped.params import (
     DEFAULT_WINDOW_S,
     GRAVITY_MPS2,
@@ -47,7 +48,6 @@ from drake_biped.params import (
     ParameterError,
     TorqueFreeWindow,
     check_settings,
-    clock_of_record,
     walked_the_distance,
     with_time_step,
 )
