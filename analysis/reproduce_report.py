@@ -13,22 +13,37 @@ from __future__ import annotations
 
 import html
 import json
-import re
 from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
-from drake_biped.analysis.floquet import record_verdict
-from drake_biped.analysis.rewalks import saving_spread, window_acted
-from drake_biped.analysis.series import cmt_change, signed_percent
-from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
-from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
-from drake_biped.records import read_json, save_figure, write_text_atomic
-
-SLOPE_LEVEL_M = 2.0  # the level ground before the dynamics step's slopes (Reproduction.dynamics)
-REPRODUCED, PARTLY, NOT_REPRODUCED, DIFFERS, BEYOND = (
-    "reproduced", "partly reproduced", "not reproduced", "differs", "beyond the paper")
-
+from drake_biped.analysis.dynamics_report import (
+    dynamics_rows,
+    dynamics_section,
+    floquet_text,
+)
+from drake_biped.analysis.report_figures import quick_summary_figure, summary_figure
+from drake_biped.analysis.report_text import (
+    BEYOND,
+    DIFFERS,
+    NOT_REPRODUCED,
+    REPRODUCED,
+    embed,
+    num,
+    pct,
+    read_markdown,
+    steps_text,
+)
+from drake_biped.analysis.verdicts import (
+    climbs_2deg,
+    reduction_verdict,
+    slope_verdict,
+    stability_verdict,
+    table_v_claim,
+    table_vii_claim,
+    table_vii_rows,
+)
+from drake_biped.records import read_json, write_text_atomic
 
 
 def _margin(margins: dict, condition: str, direction: str) -> str:
@@ -63,126 +78,6 @@ def _start_text(settings: dict) -> str:
     return f"start {learner['mean'][0]:g}, {learner['mean'][1]:g} s; σ² {learner['variance']:g}"
 
 
-def _pct(x: float | None) -> str:
-    if x is None:
-        return "—"
-    return signed_percent(x)
-
-
-def _num(x: float | None, digits: int = 3) -> str:
-    return "—" if x is None else f"{x:.{digits}f}"
-
-
-def embed(markdown: str, folder: str) -> str:
-    """A sub-report inside this one: headings two levels down, relative links prefixed with `folder`."""
-    text = re.sub(r"^(#+) ", lambda m: "#" * min(6, len(m.group(1)) + 2) + " ", markdown, flags=re.M)
-
-    def link(m: re.Match) -> str:
-        target = m.group(2)
-        if re.match(r"^[a-z]+:|^/|^#", target):
-            return m.group(0)
-        return f"{m.group(1)}({folder}/{target})"
-
-    return re.sub(r"(!?\[[^\]]*\])\(([^)\s]+)\)", link, text)
-
-
-def _read(out: Path, rel: str) -> str:
-    path = out / rel
-    return path.read_text() if path.is_file() else f"({rel} was not written)\n"
-
-
-def _windows_kept(evaluation: dict[str, Any]) -> int:
-    """How many trials of a learning evaluation end with a window that frees the hip in a walk
-    (`analysis.rewalks.window_acted`)."""
-    no_window = evaluation.get("no_window")
-    return sum(1 for r in evaluation.get("learned", []) if window_acted(r, no_window) and not r["fell"])
-
-
-def reduction_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
-    """Verdict on "the torque-free period cuts C_mt by 40-50 % and walking holds" for a learning run: judged on
-    the learned windows re-walked with the plant step halved and from a nudged start (`rewalks`) where the
-    record has them, else on one walk of each final mean."""
-    walks = evaluation.get("learned_walks", 0)
-    trials = len(evaluation.get("learned", []))
-    windows = _windows_kept(evaluation)
-    as_learned = evaluation.get("reduction")
-    rewalked = evaluation.get("rewalks")
-    if rewalked:
-        reduction = rewalked["mean_saving"]
-        spread = saving_spread(rewalked)
-        spread = f"{spread} over trials" if spread.startswith("±") else spread.strip("()")
-        ours = (f"C_mt {cmt_change(reduction)} re-walked at half the step and from "
-                f"0.95 / 1.05 × the initiation speed ({spread}; "
-                f"{rewalked['holding']} of {trials} trials save ≥ {100 * rewalked['hold_saving']:.0f} % in every "
-                f"walk); as learned {cmt_change(as_learned)}, {walks} of {trials} walk, "
-                f"{windows} end with a window")
-    else:
-        reduction = as_learned
-        ours = f"C_mt {cmt_change(reduction)} (mean of the {walks} of {trials} trials " \
-               f"that walk; {windows} end with a window; one walk each, not re-walked)"
-    if reduction is None or walks == 0:
-        return ours, NOT_REPRODUCED
-    if reduction >= 0.40:
-        return ours, REPRODUCED
-    if reduction >= 0.05:
-        return ours, f"{PARTLY}: {100 * reduction:.0f} % against the paper's {100 * PAPER_REDUCTION:.0f} %"
-    return ours, NOT_REPRODUCED
-
-
-def slope_verdict(summary: dict[str, Any]) -> tuple[str, str]:
-    v = summary["verdicts"]
-    held = [v["learned_period_fails_to_climb"], v["no_period_climbs"],
-            v["learning_shrinks_the_period_until_it_climbs"] > 0]
-    ours = (f"start period {'falls' if v['learned_period_fails_to_climb'] else 'climbs'}; none "
-            f"{'climbs' if v['no_period_climbs'] else 'falls'}; learning: "
-            f"{v['learning_shrinks_the_period_until_it_climbs']}/{v['trials']} trials end climbing")
-    if all(held):
-        return ours, REPRODUCED
-    return ours, (PARTLY if any(held) else NOT_REPRODUCED) + f" ({sum(held)} of 3 claims hold)"
-
-
-def stability_verdict(cells: dict[str, Any]) -> tuple[str, str]:
-    flat = [(c, k, cell) for c, kinds in cells.items() for k, cell in kinds.items()]
-    stable = sum(1 for *_, cell in flat if cell["stable"])
-    diffs = [abs(cell["spectral_radius"] - cell["paper_spectral_radius"]) for *_, cell in flat
-             if cell["spectral_radius"] is not None]
-    ours = f"{stable} of 6 cells stable; ρ differs from the paper's by up to {max(diffs, default=0):.2f}"
-    crossing = sum(1 for *_, cell in flat if cell["stable"] and cell.get("spectral_radius_ci")
-                   and cell["spectral_radius_ci"][1] >= 1.0)
-    if crossing:
-        ours += f" ({crossing} of them with a 95 % interval of ρ reaching above 1)"
-    if stable == 6 and crossing:
-        return ours, f"{PARTLY}: all stable by their fits, {crossing} not established; eigenvalues: {DIFFERS}"
-    if stable == 6:
-        return ours, f"{REPRODUCED} (all stable); eigenvalues: {DIFFERS}"
-    return ours, f"{NOT_REPRODUCED}: {6 - stable} cell(s) not stable"
-
-
-def climbs_2deg(summary: dict[str, Any]) -> bool:
-    """Whether any point of the 2.0 deg grid (its summary) climbs: else its best is only the furthest fall."""
-    return bool(summary.get("walked"))
-
-
-def table_vii_rows(summary: dict[str, Any]) -> tuple[list[str], str, str]:
-    """Table VII's rows (paper and ours), our changes in a line, and the verdict."""
-    base, best = summary["base_cpg"], summary["best"]["point"]
-    rows, same, changes = [], 0, []
-    for name, (before, after) in TABLE_VII_PAPER.items():
-        ours_after = best.get(f"cpg.{name}", base[name])
-        ours_change = ours_after / base[name] - 1.0
-        paper_change = after / before - 1.0
-        same += (ours_change > 0) == (paper_change > 0) and ours_change != 0
-        rows.append(f"| {name} | {before:g} → {after:g} ({_pct(paper_change)}) | {base[name]:.4g} → "
-                    f"{ours_after:.4g} ({_pct(ours_change)}) |")
-        changes.append(f"{name} {_pct(ours_change)}")
-    others = [f"{k} = {v:.4g}" for k, v in best.items() if not k.startswith("cpg.")]
-    note = f"; also {', '.join(others)}" if others else ""
-    if not climbs_2deg(summary):  # the furthest fall is no 2.0 deg gait, and its parameters no Table VII
-        return (rows, f"no point climbs (the furthest falls at {summary['best']['distance_m']:.2f} m)",
-                f"{NOT_REPRODUCED}: none of the grid's {summary['points']} points climbs 2.0°")
-    return rows, ", ".join(changes), f"{DIFFERS}: {same} of 3 CPG parameters move as in Table VII{note}"
-
-
 # The claims' rows of the full report, in order: the keys a quick run matches its own rows with.
 CLAIM_KEYS = ("table_iii", "paper_gait", "grid", "learn", "learn_variant", "compare_learners", "stability",
               "push_margin", "floquet", "attractors", "slope_premise", "table_iii_attractor", "slope", "slope2deg",
@@ -192,19 +87,6 @@ DYNAMICS_KEYS = ("attractors", "slope_premise", "table_iii_attractor")
 # The learning runs whose evaluated windows a quick run re-walks (DIR/<source>/learning.json).
 CHECKED_SOURCES = {"learn": ("learn",), "learn_variant": ("learn_variant",)}
 # The shipped gaits other than the default, and why each exists (the report's closing section).
-def _steps(n: int) -> str:
-    return f"{n} step" if n == 1 else f"{n} steps"
-
-
-def floquet_text(gaits: dict[str, Any]) -> str:
-    """Each gait's spectral radius and what it establishes; no radius where no perturbation size converged
-    (the largest eigenvalue of an unconverged Jacobian measures nothing)."""
-    return ", ".join(f"{name} ρ {_num(g['spectral_radius'])} ({record_verdict(g)})"
-                     if g.get("converged_epsilon") is not None
-                     else f"{name}: {record_verdict(g)} (Newton's residual {g['fixed_point_residual']:.1e})"
-                     for name, g in gaits.items())
-
-
 def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]]:
     """The verdict tuples as keyed rows (CLAIM_KEYS)."""
     keys = CLAIM_KEYS
@@ -213,30 +95,6 @@ def claim_rows(verdicts: list[tuple[str, str, str, str]]) -> list[dict[str, str]
     if len(verdicts) != len(keys):
         raise ValueError(f"expected {len(CLAIM_KEYS)} claims, got {len(verdicts)}")
     return [{"key": k, "what": a, "paper": b, "ours": c, "verdict": d} for k, (a, b, c, d) in zip(keys, verdicts)]
-
-
-def attractor_text(point: dict[str, Any]) -> str:
-    """A walk's attractor in words: the 2 ms reading, the jitter-scale one where it differs, the exponent."""
-    if point["fell"]:
-        return "falls"
-    text = point["attractor"]
-    jitter = (point.get("within_jitter") or {}).get("attractor")
-    if jitter and jitter != text:
-        text += f" ({jitter} at {1e3 * point['within_jitter']['tolerance_s']:g} ms)"
-    lyap = point.get("lyapunov") or {}
-    if lyap.get("exponent") is not None:
-        text += f", Lyapunov {lyap['exponent']:+.2f}/step"
-    if point.get("spread_s") is not None:
-        text += f", step periods spread {1e3 * point['spread_s']:.0f} ms"
-    return text
-
-
-def _bound(premise: dict[str, Any], key: str) -> str:
-    """A slope envelope of `bifurcation.premise`: "0.015", or "≥ 0.06" where it is the sweep's last slope."""
-    value = premise[key]
-    if value is None:
-        return "none"
-    return ("≥ " if premise.get(f"{key}_is_bound") else "") + f"{value:g}"
 
 
 def _hip_reading(paper_gait: dict[str, Any]) -> str:
@@ -248,65 +106,6 @@ def _hip_reading(paper_gait: dict[str, Any]) -> str:
         return (f"ζ the desired velocity of {joint}, realized by an effort-limited velocity motor as ODE's "
                 f"({gait['motor_limit_nm']:.3g} N·m), at {1e3 * paper_gait.get('time_step_s', 1e-3):g} ms")
     return f"ζ driving the swing thigh's angle through a soft servo (the {gait.get('swing_reading')} reading)"
-
-
-def _dynamics_walks_m(d: dict[str, Any]) -> tuple[float, float, float, float]:
-    """The dynamics step's walk lengths (m): the attractors, the sweeps, the slopes (2 m level included), the
-    basins (Profile.dynamics_walks_m, recorded in its settings)."""
-    return tuple(d["settings"]["walks_m"])
-
-
-def dynamics_rows(d: dict[str, Any], wtext: str) -> list[tuple[str, str, str, str]]:
-    """The dynamics step's verdict rows: the attractors, the slope premise, the Table III walker."""
-    none, learned = d["learned"]
-    long_m, _, slope_m, _ = _dynamics_walks_m(d)
-    rows = [(f"What the walk settles on ({long_m:g} m)", "—",
-             f"no window: {attractor_text(none)}; {wtext}: {attractor_text(learned)}", BEYOND)]
-    pr = d["premise"]
-    up = {k: "none" if pr[f"{k}_up_to"] is None else _bound(pr, f"{k}_up_to") + " rad" for k in ("without", "with")}
-    band = (f"the window fails and none climbs at {', '.join(f'{v:g}' for v in pr['band'])} rad" if pr["band"]
-            else "no slope where the window fails and none climbs")
-    rows.append(("The slope premise: the learned window cannot climb where none can", "holds at 0.02 rad",
-                 f"climbs {slope_m - SLOPE_LEVEL_M:g} m up to: none {up['without']}, {wtext} {up['with']}; {band}",
-                 REPRODUCED if pr["holds"] else NOT_REPRODUCED))
-    rows.append(("Table III, entrained reading (`paper_entrained`): a gait?", "walks",
-                 "; ".join(f"{1e3 * p['time_step_s']:g} ms: {attractor_text(p)}" for p in d["paper_entrained"]),
-                 BEYOND))
-    return rows
-
-
-def dynamics_section(out: Path, d: dict[str, Any], wtext: str) -> list[str]:
-    """The gait as a dynamical system: the bifurcation over t1, the slope envelopes, the basins."""
-    pr = d["premise"]
-    slope_m = _dynamics_walks_m(d)[2]
-    return [
-        "## The gait as a dynamical system (`dynamics/`, beyond the paper)",
-        "",
-        "Each walk is read by its step periods after the transient its sweep names: period-k where every k-th "
-        "period varies by less than 2 ms, read again at 10 ms (a controller that updates on a grid sees a "
-        "touchdown only at its next update, so even a regular gait's periods jitter by up to its update period), "
-        "irregular ones with a finite-size Lyapunov exponent from a neighbour walk (`drake-biped bifurcation`, "
-        "`drake-biped basins`).",
-        "",
-        "### Bifurcation over t1, the learned t2 kept (`dynamics/t1/`)",
-        "",
-        embed(_read(out, "dynamics/t1/bifurcation.md"), "dynamics/t1"),
-        "![bifurcation over t1](dynamics/t1/bifurcation.png)",
-        "",
-        "### The slope premise (`dynamics/slope_without/`, `dynamics/slope_with/`)",
-        "",
-        f"The steepest slope climbed for {slope_m - SLOPE_LEVEL_M:g} m after {SLOPE_LEVEL_M:g} m level (every slope "
-        "up to it climbed; the last slope of the sweep is a bound, ≥): without a window "
-        f"**{_bound(pr, 'without_up_to')}** rad, with {wtext} **{_bound(pr, 'with_up_to')}** rad. Slopes where the window falls "
-        f"and no window climbs: {', '.join(f'{v:g}' for v in pr['band']) or 'none'}. The paper's slope story "
-        "needs such a band; its 0.02 rad is run as printed in the slope stories below.",
-        "",
-        "### Where starts end (`dynamics/basins/`)",
-        "",
-        embed(_read(out, "dynamics/basins/basins.md"), "dynamics/basins"),
-        "![basins](dynamics/basins/basins.png)",
-        "",
-    ]
 
 
 def table_iii_rank(out: Path) -> tuple[int, int] | None:
@@ -340,7 +139,7 @@ def walk_section(walk: dict[str, Any], gait: str = "paper") -> list[str]:
         "## The walk (`walk/`)",
         "",
         f"{gait_label(gait)[0].upper()}{gait_label(gait)[1:]} from the paper's initiation: {walk['distance_m']:.2f} m, C_mt "
-        f"{format_cost(walk['cost_of_transport'], '—')}, {walk['mean_speed_mps']:.2f} m/s, step {_num(walk['step_period_s'])} s, "
+        f"{format_cost(walk['cost_of_transport'], '—')}, {walk['mean_speed_mps']:.2f} m/s, step {num(walk['step_period_s'])} s, "
         f"real-time factor {walk['real_time_factor']:.1f}. Animation: [walk.html](walk/walk.html) (Meshcat), "
         "[walk.gif](walk/walk.gif); record: [result.json](walk/result.json).",
         "",
@@ -363,11 +162,11 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     grid = s["grid"]
     t3 = grid["table_iii"]
     verdicts.append((f"Table III walks ({label}'s other gains)", "walks (the grid's best)",
-                     ("walks" if not t3["fell"] else f"falls after {_steps(t3['steps'])}")
+                     ("walks" if not t3["fell"] else f"falls after {steps_text(t3['steps'])}")
                      + f", {t3['distance_m']:.2f} m", REPRODUCED if not t3["fell"] else NOT_REPRODUCED))
     pg = s["paper_gait"]
     verdicts.append(("Table III walks, ζ driving the swing as printed (unprinted gains searched)", "walks",
-                     ("walks" if not pg["fell"] else f"falls after {_steps(pg['steps'])}") + f", {pg['distance_m']:.2f} m",
+                     ("walks" if not pg["fell"] else f"falls after {steps_text(pg['steps'])}") + f", {pg['distance_m']:.2f} m",
                      REPRODUCED if not pg["fell"] else NOT_REPRODUCED))
     best = grid["best"]
     ranked = table_iii_rank(out)
@@ -376,7 +175,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
                      f"{best['distance_m']:.2f} m of {grid['points']} points ({grid['walked']} walk "
                      f"{profile.distance_m:g} m){rank_text}", REPRODUCED if ranked and ranked[0] == 1 else DIFFERS))
     learn_ours, learn_verdict = reduction_verdict(s["learn"]["evaluation"])
-    verdicts.append(("Table V: C_mt reduction by learning (paper's settings)", "−50 % (0.58 → 0.29)",
+    verdicts.append(("Table V: C_mt reduction by learning (paper's settings)", table_v_claim(),
                      learn_ours, learn_verdict))
     var_ours, var_verdict = reduction_verdict(s["learn_variant"]["evaluation"])
     verdicts.append(("C_mt reduction, exploration matched to the gait", "—", var_ours, f"{BEYOND}; {var_verdict}"))
@@ -403,7 +202,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         ours, verdict = slope_verdict(s[name])
         verdicts.append((claim, "all three claims", ours, verdict))
     vii_rows, vii_changes, vii_verdict = table_vii_rows(s["grid_slope2deg"])
-    verdicts.append(("Table VII: CPG parameters for 2.0°", "u_a +37 %, u_r +25 %, κ +51 %", vii_changes,
+    verdicts.append(("Table VII: CPG parameters for 2.0°", table_vii_claim(), vii_changes,
                      vii_verdict))
     ts = s["time_step"]
     chosen = "none" if ts["chosen_step_s"] is None else f"{1e3 * ts['chosen_step_s']:g} ms"
@@ -441,7 +240,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"{grid['walked']} walk {profile.distance_m:g} m; the furthest, {best['distance_m']:.2f} m, at "
         + ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in best["point"].items())
         + f". Table III itself (with {label}'s other gains) "
-        + ("walks" if not t3["fell"] else f"falls after {_steps(t3['steps'])}")
+        + ("walks" if not t3["fell"] else f"falls after {steps_text(t3['steps'])}")
         + f" ({t3['distance_m']:.2f} m)"
         + ("" if ranked is None else f" and ranks {ranked[0]} of {ranked[1]} among them, further then cheaper "
            "first")
@@ -456,7 +255,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         f"The shipped gait `paper`: Table III's CPG ({', '.join(f'{k} {v:g}' for k, v in pg['cpg'].items())}) and the "
         f"paper's initiation, {_hip_reading(pg)}, the gains the paper does not print searched (the gait's `about`): "
-        + (f"walks {pg['distance_m']:.2f} m" if not pg["fell"] else f"falls after {_steps(pg['steps'])} ({pg['fall_reason']}), "
+        + (f"walks {pg['distance_m']:.2f} m" if not pg["fell"] else f"falls after {steps_text(pg['steps'])} ({pg['fall_reason']}), "
                                               f"{pg['distance_m']:.2f} m")
         + ". Record: [result.json](paper_gait/result.json).",
         "",
@@ -469,7 +268,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"{wm['walked']} of {wm['windows']} windows walk {profile.distance_m:g} m; no window C_mt "
         f"{format_cost(wm['no_window_cost_of_transport'], '—')}"
         + ("" if wbest is None else f"; the cheapest, {wbest['t1']:g}–{wbest['t2']:g} s, C_mt "
-           f"{format_cost(wbest['cost_of_transport'], '—')} ({_pct(wbest['cmt_change'])})") + ".",
+           f"{format_cost(wbest['cost_of_transport'], '—')} ({pct(wbest['cmt_change'])})") + ".",
         "",
         "![window map](window_map/window_map.png)",
         "",
@@ -477,11 +276,11 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         f"Verdict: **{learn_verdict}**. {s['learn']['settings']['trials']} trials × "
         f"{s['learn']['settings']['episodes']} episodes, the paper's settings ({_start_text(s['learn']['settings'])}; "
-        f"Table II); {_num(s['learn']['episodes_per_min'], 1)} episodes/min. Each trial's final policy mean is "
+        f"Table II); {num(s['learn']['episodes_per_min'], 1)} episodes/min. Each trial's final policy mean is "
         "re-walked with the plant step halved and from 0.95 and 1.05 × the initiation speed, each against no "
         "window under the same change.",
         "",
-        embed(_read(out, "learn/table_v.md"), "learn"),
+        embed(read_markdown(out, "learn/table_v.md"), "learn"),
         "![Fig. 4](learn/fig4_reward.png)",
         "![Fig. 5](learn/fig5_cmt.png)",
         "![Fig. 6](learn/fig6_times.png)",
@@ -491,14 +290,14 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         f"Verdict: **{var_verdict}**. {_start_text(s['learn_variant']['settings']).capitalize()}, where the "
         "paper's is 0.5, 0.5 s with σ² 0.04 (σ = 0.2 s).",
         "",
-        embed(_read(out, "learn_variant/table_v.md"), "learn_variant"),
+        embed(read_markdown(out, "learn_variant/table_v.md"), "learn_variant"),
         "![Fig. 6, variant](learn_variant/fig6_times.png)",
         "",
         f"## Pushes and return maps (Table VI, Fig. 7; `stability/`), {wname} {wtext}",
         "",
         f"Verdict: **{stab_verdict}**. The window: {source}.",
         "",
-        embed(_read(out, "stability/report.md"), "stability"),
+        embed(read_markdown(out, "stability/report.md"), "stability"),
         "### Push margins (`push_margin/`)",
         "",
         _margin_method(s["push_margin"]["settings"], s["push_margin"].get("method")),
@@ -518,7 +317,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
     ]
     for name in s["floquet"]["gaits"]:
-        lines += [embed(_read(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
+        lines += [embed(read_markdown(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
                   f"![Floquet multipliers, {name}](floquet/{name}/floquet.png)", ""]
     if "dynamics" in s:
         lines += dynamics_section(out, s["dynamics"], wtext)
@@ -555,7 +354,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
             + ("" if not point else " with " + ", ".join(f"{k.split('.')[-1]} {v:.4g}" for k, v in point.items()))
             + ".",
             "",
-            embed(_read(out, f"{name}/report.md"), name),
+            embed(read_markdown(out, f"{name}/report.md"), name),
             f"![period]({name}/fig8_period.png)",
             f"![distance]({name}/fig9_distance.png)",
             "",
@@ -563,12 +362,12 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
     lines += [
         "## Learners side by side (`compare_learners/`, beyond the paper)",
         "",
-        embed(_read(out, "compare_learners/compare.md"), "compare_learners"),
+        embed(read_markdown(out, "compare_learners/compare.md"), "compare_learners"),
         "![learners](compare_learners/compare.png)",
         "",
         "## Time step (`time_step/`)",
         "",
-        embed(_read(out, "time_step/time_step_study.md"), "time_step"),
+        embed(read_markdown(out, "time_step/time_step_study.md"), "time_step"),
         "![time step](time_step/time_step_study.png)",
         "",
         *other_gaits_section(gait),
@@ -592,10 +391,6 @@ def other_gaits_section(gait: str = "paper") -> list[str]:
     return lines + [""]
 
 
-VERDICT_COLOURS = ((REPRODUCED, "#c8e6c9"), (PARTLY, "#ffe0b2"), (DIFFERS, "#ffe0b2"), (NOT_REPRODUCED, "#ffcdd2"),
-                   (BEYOND, "#e0e0e0"))
-
-
 def window_name(source: str) -> str:
     """What the story's window is, in words, from where it came (Reproduction.learned_window's source): "the
     learned window" when a trial learned it, else "the window map's cheapest window", else (no window of the map
@@ -613,42 +408,6 @@ def _window_text(window) -> str:
 def _ms(config: dict[str, Any]) -> str:
     """A recorded configuration's plant time step, in ms."""
     return f"{1e3 * config['sim']['time_step_s']:g} ms"
-
-
-def summary_figure(verdicts: list[tuple[str, str, str, str]], title: str, path: Path) -> None:
-    """The verdict table as a picture: one row per claim, the verdict cell coloured."""
-    import textwrap
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    widths = (34, 26, 44, 34)
-    cells = [["\n".join(textwrap.wrap(text.replace("**", ""), w)) or "—" for text, w in zip(row, widths)]
-             for row in verdicts]
-    heights = [max(c.count("\n") + 1 for c in row) for row in cells]
-    fig_h = 0.9 + 0.2 * (sum(heights) + len(heights))
-    fig, ax = plt.subplots(figsize=(13, fig_h))
-    ax.axis("off")
-    table = ax.table(cellText=cells, colLabels=["claim", "paper", "ours", "verdict"], loc="upper center",
-                     cellLoc="left", colWidths=[w / sum(widths) for w in widths])
-    table.auto_set_font_size(False)
-    table.set_fontsize(8)
-    total = sum(heights) + len(heights) + 1
-    for (r, c), cell in table.get_celld().items():
-        h = 1 if r == 0 else heights[r - 1] + 1
-        cell.set_height(h / total * 0.95)
-        if r == 0:
-            cell.set_facecolor("#eeeeee")
-        elif c == 3:
-            for key, colour in VERDICT_COLOURS:
-                if verdicts[r - 1][3].startswith(key):
-                    cell.set_facecolor(colour)
-                    break
-    ax.set_title(title, fontsize=10)
-    save_figure(fig, path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
 
 
 def _profile_text(p: Any, ran: list[str] | None = None) -> str:
@@ -758,11 +517,11 @@ def quick_rows(s: dict[str, dict[str, Any]], full_run: dict[str, Any] | None) ->
     mine: dict[str, tuple[str, str]] = {}
     if "table_iii" in s:
         t3 = s["table_iii"]
-        mine["table_iii"] = (("walks" if not t3["fell"] else f"falls after {_steps(t3['steps'])}")
+        mine["table_iii"] = (("walks" if not t3["fell"] else f"falls after {steps_text(t3['steps'])}")
                              + f", {t3['distance_m']:.2f} m", REPRODUCED if not t3["fell"] else NOT_REPRODUCED)
     if "paper_gait" in s:
         pg = s["paper_gait"]
-        mine["paper_gait"] = (("walks" if not pg["fell"] else f"falls after {_steps(pg['steps'])}")
+        mine["paper_gait"] = (("walks" if not pg["fell"] else f"falls after {steps_text(pg['steps'])}")
                               + f", {pg['distance_m']:.2f} m", REPRODUCED if not pg["fell"] else NOT_REPRODUCED)
     if "learn" in s:
         ours, _ = reduction_verdict(s["learn"]["evaluation"])
@@ -864,7 +623,7 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
     for check in fr.get("checks", {}).values():
         for w in check["rows"]:
             window = "none" if w["t2"] <= max(0.0, w["t1"]) else f"{max(0.0, w['t1']):.3f}–{w['t2']:.3f}"
-            lines.append(f"| {check['source']} | {window} | {_num(w['recorded'], 6)} | {_num(w['measured'], 6)} | "
+            lines.append(f"| {check['source']} | {window} | {num(w['recorded'], 6)} | {num(w['measured'], 6)} | "
                          + ("yes" if w["recorded"] == w["measured"] else
                             f"{'agrees' if w.get('agrees') else 'no'}"
                             + ("" if w["relative_difference"] is None else f": {100 * w['relative_difference']:+.3f} %"))
@@ -873,51 +632,12 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         lines += ["", "## Learning, a few episodes (`learn/`)", "",
                   f"GARB with the paper's settings for {s['learn']['settings']['trials']} × "
                   f"{s['learn']['settings']['episodes']} episodes: the machinery of Experiment 1, too short to "
-                  "judge it.", "", embed(_read(out, "learn/table_v.md"), "learn"),
+                  "judge it.", "", embed(read_markdown(out, "learn/table_v.md"), "learn"),
                   "![Fig. 4](learn/fig4_reward.png)", ""]
     if "floquet" in s:
         for name in s["floquet"]["gaits"]:
-            lines += [embed(_read(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
+            lines += [embed(read_markdown(out, f"floquet/{name}/floquet.md"), f"floquet/{name}"),
                       f"![Floquet multipliers, {name}](floquet/{name}/floquet.png)", ""]
     lines += [f"The full report with every experiment: `{full_run_records(full_run)}/report.md` in the "
               "repository; `drake-biped reproduce --out DIR` (without `--quick`) runs it.", ""]
     return "\n".join(lines)
-
-
-def quick_summary_figure(rows: list[dict[str, str]], path: Path, full_gait: str | None = None) -> None:
-    """The quick report's table as a picture: this run's column beside the full run's, each verdict coloured;
-    `full_gait`: the full run's gait when it is not the default (full_run_gait)."""
-    import textwrap
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    widths = (30, 20, 40, 50)
-    table_rows = [(r["what"], r["paper"], r["this_run"] + (f" — {r['this_verdict']}" if r["this_verdict"] else ""),
-                   r["full_run"]) for r in rows]
-    cells = [["\n".join(textwrap.wrap(text.replace("**", ""), w)) or "—" for text, w in zip(row, widths)]
-             for row in table_rows]
-    heights = [max(c.count("\n") + 1 for c in row) for row in cells]
-    fig, ax = plt.subplots(figsize=(14, 0.9 + 0.2 * (sum(heights) + len(heights))))
-    ax.axis("off")
-    table = ax.table(cellText=cells, colLabels=["claim", "paper", "this run (quick)", "full run (checked here)"],
-                     loc="upper center", cellLoc="left", colWidths=[w / sum(widths) for w in widths])
-    table.auto_set_font_size(False)
-    table.set_fontsize(8)
-    total = sum(heights) + len(heights) + 1
-    for (r, c), cell in table.get_celld().items():
-        cell.set_height((1 if r == 0 else heights[r - 1] + 1) / total * 0.95)
-        if r == 0:
-            cell.set_facecolor("#eeeeee")
-            continue
-        verdict = {2: rows[r - 1]["this_verdict"], 3: rows[r - 1]["full_verdict"]}.get(c)
-        for key, colour in VERDICT_COLOURS:
-            if verdict and verdict.startswith(key):
-                cell.set_facecolor(colour)
-                break
-    ax.set_title("drake-biped reproduce (quick): this run beside the shipped full run"
-                 + (f" (measured on {full_gait.strip('`')})" if full_gait else ""), fontsize=10)
-    save_figure(fig, path, dpi=110, bbox_inches="tight")
-    plt.close(fig)

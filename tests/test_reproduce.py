@@ -6,17 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from drake_biped.analysis.reproduce_report import (
-    NOT_REPRODUCED,
-    PARTLY,
-    REPRODUCED,
-    embed,
-    floquet_text,
-    reduction_verdict,
-    slope_verdict,
-    stability_verdict,
-    table_vii_rows,
-)
+from drake_biped.analysis.dynamics_report import floquet_text
+from drake_biped.analysis.report_text import NOT_REPRODUCED, PARTLY, REPRODUCED, embed
+from drake_biped.analysis.verdicts import reduction_verdict, slope_verdict, stability_verdict, table_vii_rows
 from drake_biped.experiments.reproduce import QUICK, Profile, Reproduction, check_out, steps_of
 from drake_biped.params import ParameterError
 

@@ -145,7 +145,8 @@ def test_rewalk_refuses_a_file_that_is_not_a_learning_record(tmp_path, capsys):
 def test_table_vs_verdict_is_judged_on_the_rewalked_saving():
     """As learned the windows save 48 %; re-walked, 20 %: the verdict is the re-walked one (partly), and a
     record without re-walks says it judged one walk each."""
-    from drake_biped.analysis.reproduce_report import NOT_REPRODUCED, PARTLY, REPRODUCED, reduction_verdict
+    from drake_biped.analysis.report_text import NOT_REPRODUCED, PARTLY, REPRODUCED
+    from drake_biped.analysis.verdicts import reduction_verdict
 
     evaluation = {"reduction": 0.48, "learned_walks": 5,
                   "learned": [{"t1": 0.1, "t2": 0.5, "fell": False} for _ in range(5)]}

@@ -633,7 +633,7 @@ class Reproduction:
 
     def slope2deg(self) -> dict:
         """The slope story on 2.0 deg with the 2.0 deg grid's best point (the gait itself when none climbs)."""
-        from drake_biped.analysis.reproduce_report import climbs_2deg
+        from drake_biped.analysis.verdicts import climbs_2deg
 
         grid = self.summary("grid_slope2deg")
         return self._slope("slope2deg", SLOPE_2DEG_RAD_PRINTED, grid["best"]["point"] if climbs_2deg(grid) else None)
