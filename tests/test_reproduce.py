@@ -116,8 +116,8 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
 
     logs = []
     with dask_client(workers=2) as client:
-        summaries = Reproduction(tmp_path, SMOKE, client, workers=2, log=logs.append, gait="default").run_all()
-    assert list(summaries) == list(steps_of(SMOKE, "default")) and "full_run" not in summaries
+        summaries = Reproduction(tmp_path, SMOKE, client, workers=2, log=logs.append, gait="fast_servo").run_all()
+    assert list(summaries) == list(steps_of(SMOKE, "fast_servo")) and "full_run" not in summaries
     text = (tmp_path / "report.md").read_text()
     for heading in SECTIONS:
         assert heading in text, heading
@@ -160,8 +160,8 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     assert summaries["grid_slope2deg"]["base_cpg"] == summaries["learn"]["settings"]["config"]["cpg"]
 
     logs.clear()
-    again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append, gait="default").run_all()
-    assert logs == [f"[{step}] finished earlier: reused" for step in steps_of(SMOKE, "default")]
+    again = Reproduction(tmp_path, SMOKE, None, workers=2, log=logs.append, gait="fast_servo").run_all()
+    assert logs == [f"[{step}] finished earlier: reused" for step in steps_of(SMOKE, "fast_servo")]
     # the same numbers, each step now named as reused from the folder's records, not measured by this run
     assert all(s.pop("reused") for s in again.values()) and again == summaries
     from drake_biped.analysis.reproduce_report import provenance_text
