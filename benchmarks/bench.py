@@ -1,7 +1,8 @@
-"""Speed of the walking episode: plant alone vs closed loop per time step, episodes per minute, Dask 1 vs 2
-workers, import and build time, peak memory per worker.
+"""Speed of the walking episode: plant alone vs closed loop per time step for each gait (the paper's walker,
+`paper`, and our own faster gait, `fast_servo`), episodes per minute, Dask 1 vs 2 workers, import and build time,
+peak memory per worker.
 
-    python benchmarks/bench.py --out out/bench            # about 3 minutes on 2 cores
+    python benchmarks/bench.py --out out/bench            # about 10 minutes on 2 cores
     python benchmarks/bench.py --out out/bench --quick    # one repeat, two time steps, 2 m, small Dask run
 
 Writes OUT/benchmarks.json (every sample, with the versions and the machine) and OUT/benchmarks.md (tables).
@@ -18,6 +19,7 @@ load affects all of them alike; tables give medians.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import platform
@@ -37,16 +39,21 @@ from drake_biped.diagram import build_replay_diagram, initial_state
 from drake_biped.episode import run_episode
 from drake_biped.kinematics import center_of_mass
 from drake_biped.params import EpisodeConfig, SimulationParams, TorqueFreeWindow
+from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
 DASK_WINDOWS = [None, (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.1, 0.5), (0.2, 0.6), (0.1, 0.3), (0.2, 0.4)]
 
 
-def config_at(step: float, distance: float, window: tuple[float, float] | None = None) -> EpisodeConfig:
-    """The default gait at plant and control step `step`, walking `distance` metres."""
-    sim = SimulationParams(time_step_s=step, control_period_s=step, distance_m=distance)
+def config_at(step: float | None, distance: float, window: tuple[float, float] | None = None,
+              gait: str = "paper") -> EpisodeConfig:
+    """The shipped gait `gait` at plant and control step `step` (None: its own), walking `distance` metres."""
+    base = load_gait(gait)
+    step = base.sim.time_step_s if step is None else step
+    sim = SimulationParams(time_step_s=step, control_period_s=step, distance_m=distance,
+                           max_time_s=max(base.sim.max_time_s, 6.0 * distance))
     w = TorqueFreeWindow(*window) if window else TorqueFreeWindow(0.0, 0.0)
-    return EpisodeConfig(sim=sim, window=w)
+    return base.replace(sim=sim, window=w)
 
 
 def time_import(module: str, repeats: int) -> list[float]:
@@ -134,37 +141,40 @@ def replay_directly(config: EpisodeConfig, times: np.ndarray, torques: np.ndarra
     return time.perf_counter() - t, plant.GetPositions(plant_context)
 
 
-def real_time_factors(steps: list[float], distance: float, repeats: int) -> dict:
-    """Plant alone vs closed loop at each time step, interleaved, `repeats` rounds."""
+def real_time_factors(steps: list[float], distance: float, repeats: int, gaits: list[str]) -> dict:
+    """Plant alone vs closed loop for each gait at each time step, interleaved, `repeats` rounds."""
     logged = {}
-    for h in steps:
-        r = run_episode(config_at(h, distance), record_trajectory=True)
-        logged[h] = r
-        print(f"  recorded {h * 1e3:g} ms: {r.duration_s:.2f} s simulated, {r.distance_m:.2f} m, fell={r.fell}")
-    samples = {h: {"plant": [], "closed": [], "episode_wall": [], "replay_error_m": None} for h in steps}
+    runs = [(g, h) for g in gaits for h in steps]
+    for g, h in runs:
+        r = run_episode(config_at(h, distance, gait=g), record_trajectory=True)
+        logged[g, h] = r
+        print(f"  recorded {g} at {h * 1e3:g} ms: {r.duration_s:.2f} s simulated, {r.distance_m:.2f} m, fell={r.fell}")
+    samples = {run: {"plant": [], "closed": [], "episode_wall": [], "replay_error_m": None} for run in runs}
     for k in range(repeats):
-        for h in steps:
-            ref = logged[h]
-            cfg = config_at(h, distance)
+        for g, h in runs:
+            ref = logged[g, h]
+            cfg = config_at(h, distance, gait=g)
             end = float(ref.trajectory["time"][-1])  # the last logged state
             wall, q_end = replay(cfg, ref.trajectory["time"], ref.trajectory["actuation"], end)
-            samples[h]["plant"].append(end / wall)
-            samples[h]["replay_error_m"] = float(np.max(np.abs(q_end[:2] - ref.trajectory["positions"][-1][:2])))
+            s = samples[g, h]
+            s["plant"].append(end / wall)
+            s["replay_error_m"] = float(np.max(np.abs(q_end[:2] - ref.trajectory["positions"][-1][:2])))
             t = time.perf_counter()
             r = run_episode(cfg)
-            samples[h]["episode_wall"].append(time.perf_counter() - t)
-            samples[h]["closed"].append(r.real_time_factor)
-            print(f"  round {k + 1}/{repeats} {h * 1e3:g} ms: plant {samples[h]['plant'][-1]:.2f}x, "
+            s["episode_wall"].append(time.perf_counter() - t)
+            s["closed"].append(r.real_time_factor)
+            print(f"  round {k + 1}/{repeats} {g} {h * 1e3:g} ms: plant {s['plant'][-1]:.2f}x, "
                   f"closed loop {r.real_time_factor:.2f}x", flush=True)
     rows = []
-    for h in steps:
-        s = samples[h]
+    for g, h in runs:
+        s = samples[g, h]
         plant, closed = statistics.median(s["plant"]), statistics.median(s["closed"])
         rows.append({
+            "gait": g,
             "time_step_s": h,
-            "simulated_s": logged[h].duration_s,
-            "distance_m": logged[h].distance_m,
-            "fell": logged[h].fell,
+            "simulated_s": logged[g, h].duration_s,
+            "distance_m": logged[g, h].distance_m,
+            "fell": logged[g, h].fell,
             "plant_alone_rtf": plant,
             "closed_loop_rtf": closed,
             "ratio": closed / plant,
@@ -176,18 +186,19 @@ def real_time_factors(steps: list[float], distance: float, repeats: int) -> dict
     return {"distance_m": distance, "repeats": repeats, "rows": rows}
 
 
-def python_floor(distance: float, repeats: int) -> dict:
-    """At 1 ms: the plant alone, plus an empty Python update, plus one that only moves the controller's
-    inputs and outputs, plus the real controller computing alongside (its torques unused): microseconds
-    of wall time per simulated millisecond, medians of `repeats` interleaved rounds."""
-    config = config_at(1e-3, distance)
+def python_floor(distance: float, repeats: int, gait: str = "paper") -> dict:
+    """At the gait's own step: the plant alone, plus an empty Python update, plus one that only moves the
+    controller's inputs and outputs, plus the real controller computing alongside (its torques unused):
+    microseconds of wall time per simulated millisecond, medians of `repeats` interleaved rounds."""
+    config = config_at(None, distance, gait=gait)
+    h = config.sim.time_step_s
     ref = run_episode(config, record_trajectory=True)
     times, torques = ref.trajectory["time"], ref.trajectory["actuation"]
     duration = float(times[-1])
     variants = {
         "plant alone": lambda: None,
-        "+ empty Python update": lambda: EmptyUpdate(1e-3),
-        "+ the controller's I/O only": lambda: EmptyUpdate(1e-3, io=True),
+        "+ empty Python update": lambda: EmptyUpdate(h),
+        "+ the controller's I/O only": lambda: EmptyUpdate(h, io=True),
         "+ the controller": lambda: CpgWalkingController(config),
     }
     samples: dict[str, list[float]] = {name: [] for name in variants}
@@ -200,16 +211,17 @@ def python_floor(distance: float, repeats: int) -> dict:
     for r in rows:
         r["ratio_to_plant"] = base / r["us_per_ms"]
     print("  " + ", ".join(f"{r['variant']}: {r['us_per_ms']:.0f} us/ms" for r in rows))
-    return {"distance_m": distance, "simulated_s": duration, "repeats": repeats, "rows": rows}
+    return {"gait": gait, "time_step_s": h, "distance_m": distance, "simulated_s": duration, "repeats": repeats,
+            "rows": rows}
 
 
 def contact_approximations(distance: float) -> list[dict]:
     """The closed loop under each of Drake's discrete contact approximations, with and without a window."""
     rows = []
     for approx in SimulationParams.CONTACT_APPROXIMATIONS:
-        for window in (None, (0.2, 0.5)):
-            base = config_at(1e-3, distance, window)
-            r = run_episode(base.replace(sim=SimulationParams(distance_m=distance, contact_approximation=approx)))
+        for window in (None, (0.1, 0.2)):
+            base = config_at(None, distance, window)
+            r = run_episode(base.replace(sim=dataclasses.replace(base.sim, contact_approximation=approx)))
             rows.append({"approximation": approx, "window": window, "walked": not r.fell,
                          "distance_m": r.distance_m, "cost_of_transport": r.cost_of_transport,
                          "real_time_factor": r.real_time_factor})
@@ -221,7 +233,7 @@ def contact_approximations(distance: float) -> list[dict]:
 def dask_runs(worker_counts: list[int], n_episodes: int, distance: float) -> list[dict]:
     """The same episodes on LocalClusters of each size, in the order 1, 2, 2, 1 (...), so that a drift in
     machine speed affects every size alike; one row per size with the mean wall time of its runs."""
-    configs = [config_at(1e-3, distance, DASK_WINDOWS[i % len(DASK_WINDOWS)]).to_dict() for i in range(n_episodes)]
+    configs = [config_at(None, distance, DASK_WINDOWS[i % len(DASK_WINDOWS)]).to_dict() for i in range(n_episodes)]
     runs: dict[int, list[dict]] = {n: [] for n in worker_counts}
     for n in worker_counts + worker_counts[::-1]:
         t0 = time.perf_counter()
@@ -261,7 +273,7 @@ def learning_mix(n_episodes: int, workers: int, seed: int = 0) -> dict:
     variance 0.04 s^2 per component, negative times clipped to 0), 10 m or a fall, on `workers` workers."""
     rng = np.random.default_rng(seed)
     windows = np.clip(rng.normal(0.5, 0.2, size=(n_episodes, 2)), 0.0, None)
-    configs = [config_at(1e-3, 10.0, (float(a), float(b))).to_dict() for a, b in windows]
+    configs = [config_at(None, 10.0, (float(a), float(b))).to_dict() for a, b in windows]
     with dask_client(workers=workers) as client:
         client.submit(sum, [1, 2]).result()
         t0 = time.perf_counter()
@@ -284,39 +296,39 @@ def markdown(record: dict) -> str:
         f"{record['machine']['cpus']} CPUs, {record['machine']['platform']}, Python {record['machine']['python']}, "
         f"Drake {record['versions']['drake']}, commit {record['versions']['git_commit']}, {record['date']}.",
         "",
-        f"## Real-time factor, {record['rtf']['distance_m']:g} m walk (default gait, no window), "
+        f"## Real-time factor, {record['rtf']['distance_m']:g} m walk (no window), "
         f"median of {record['rtf']['repeats']}",
         "",
-        "| time step | simulated | plant alone | closed loop | closed / plant | episode wall | episodes/min |",
-        "|---|---|---|---|---|---|---|",
+        "| gait | time step | simulated | plant alone | closed loop | closed / plant | episode wall | episodes/min |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in record["rtf"]["rows"]:
         lines.append(
-            f"| {r['time_step_s'] * 1e3:g} ms | {r['simulated_s']:.2f} s{' (fell)' if r['fell'] else ''} | "
+            f"| {r.get('gait', 'paper')} | {r['time_step_s'] * 1e3:g} ms | {r['simulated_s']:.2f} s{' (fell)' if r['fell'] else ''} | "
             f"{r['plant_alone_rtf']:.2f}× | {r['closed_loop_rtf']:.2f}× | {r['ratio']:.2f} | "
             f"{r['episode_wall_s']:.2f} s | {r['episodes_per_min']:.1f} |"
         )
     lines += ["", "Plant alone: the same plant replaying the closed loop's logged torques (largest final position "
               "difference from the closed loop: "
               + ", ".join(f"{r['replay_max_position_error_m']:.1e} m" for r in record["rtf"]["rows"]) + ")."]
-    if record.get("floor"):
-        f = record["floor"]
-        lines += ["", f"## Where the closed loop's time goes, 1 ms ({f['simulated_s']:.1f} simulated s, "
-                  f"median of {f['repeats']})", "",
+    for f in record.get("floors", []):
+        lines += ["", f"## Where the closed loop's time goes: {f['gait']} at {1e3 * f['time_step_s']:g} ms "
+                  f"({f['simulated_s']:.1f} simulated s, median of {f['repeats']})", "",
                   "Each variant replays the same logged torques; the systems added compute alongside the plant "
                   "without driving it.", "",
                   "| variant | wall µs per simulated ms | plant alone / variant |", "|---|---|---|"]
         for r in f["rows"]:
             lines.append(f"| {r['variant']} | {r['us_per_ms']:.0f} | {r['ratio_to_plant']:.2f} |")
     if record.get("contact"):
-        lines += ["", f"## Contact approximation, 1 ms closed loop, {record['rtf']['distance_m']:g} m", "",
+        lines += ["", f"## Contact approximation, the paper's walker at its own step, {record['rtf']['distance_m']:g} m", "",
                   "| approximation | window | walked | distance | C_mt | real-time factor |", "|---|---|---|---|---|---|"]
         for r in record["contact"]:
             cmt = "—" if r["cost_of_transport"] is None else f"{r['cost_of_transport']:.4f}"
             lines.append(f"| {r['approximation']} | {r['window'] or 'none'} | {'yes' if r['walked'] else 'no'} | "
                          f"{r['distance_m']:.2f} m | {cmt} | {r['real_time_factor']:.2f}× |")
     if record.get("dask"):
-        lines += ["", f"## Dask LocalCluster, 1 ms, {record['dask'][0]['distance_m']:g} m episodes with assorted windows", "",
+        lines += ["", f"## Dask LocalCluster, the paper's walker at its own step, {record['dask'][0]['distance_m']:g} m "
+                  "episodes with assorted windows", "",
                   "Sizes run in the order 1, 2, 2, 1; wall = mean of the two runs of a size. "
                   f"Same C_mt in every run and size: {record['dask'][0]['same_results_for_every_size']}.", "",
                   "| workers | episodes | wall | episodes/min | speed-up | cluster start | peak memory/worker |",
@@ -356,14 +368,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", type=Path, default=Path("out/bench"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--distance", type=float, default=10.0)
-    p.add_argument("--steps", default="0.0005,0.001,0.002,0.005", help="time steps (s), comma-separated")
+    p.add_argument("--steps", default="0.0005,0.001,0.002", help="time steps (s), comma-separated")
+    p.add_argument("--gaits", default="paper,fast_servo", help="shipped gaits, comma-separated")
     p.add_argument("--dask-episodes", type=int, default=8, help="0 skips the Dask runs")
     p.add_argument("--quick", action="store_true", help="one repeat, 1 and 2 ms, 2 m, 2 Dask episodes")
     args = p.parse_args(argv)
     steps = [float(s) for s in args.steps.split(",")]
     repeats, distance, n_dask = args.repeats, args.distance, args.dask_episodes
     if args.quick:
-        steps, repeats, distance, n_dask = [1e-3, 2e-3], 1, 2.0, 2
+        steps, repeats, distance, n_dask = [5e-4, 1e-3], 1, 2.0, 2
     if repeats < 1 or distance <= 0 or n_dask < 0 or any(h <= 0 for h in steps):
         p.error("--repeats >= 1, --distance > 0, --dask-episodes >= 0 and positive --steps are required")
     args.out.mkdir(parents=True, exist_ok=True)
@@ -377,9 +390,10 @@ def main(argv: list[str] | None = None) -> int:
         "build_s": time_build(EpisodeConfig(), 5),
     }
     print("real-time factors")
-    record["rtf"] = real_time_factors(steps, distance, repeats)
-    print("where the time goes (1 ms)")
-    record["floor"] = python_floor(distance, max(repeats, 3))
+    gaits = [g for g in args.gaits.split(",") if g]
+    record["rtf"] = real_time_factors(steps, distance, repeats, gaits)
+    print("where the time goes (each gait at its own step)")
+    record["floors"] = [python_floor(distance, max(repeats, 3), g) for g in gaits]
     print("contact approximations")
     record["contact"] = contact_approximations(distance)
     if n_dask:

@@ -54,7 +54,7 @@ args = parser.parse_args()
 
 def main() -> None:
     base = db.EpisodeConfig().override({"sim.distance_m": args.distance})
-    learner = db.make_learner("one-plus-one", mean=(0.3, 0.4), variance=0.01, seed=0)
+    learner = db.make_learner("one-plus-one", mean=(0.1, 0.2), variance=0.01, seed=0)
     for episode in range(1, args.episodes + 1):
         t1, t2 = learner.ask()
         result = db.run_episode(base.replace(window=db.TorqueFreeWindow(max(0.0, t1), max(0.0, t2))))

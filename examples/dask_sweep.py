@@ -11,7 +11,7 @@ import drake_biped as db
 from drake_biped.cli import integer, number, run_script, script_parser  # the commands' option checks
 from drake_biped.common.executor import dask_client, episode_task
 
-WINDOWS = [(0.0, 0.0), (0.1, 0.4), (0.2, 0.5), (0.3, 0.6), (0.1, 0.6), (0.2, 0.7)]
+WINDOWS = [(0.0, 0.0), (0.1, 0.2), (0.1, 0.3), (0.5, 0.6), (0.1, 0.4), (0.2, 0.5)]
 
 
 def main() -> None:

@@ -5,7 +5,7 @@
 The robot is a model file (URDF or SDFormat) with the shipped model's link and joint names; the controller reads
 its body (joint positions, centres of mass, foot contact spheres, masses) from the plant. Here the shipped URDF
 is copied and edited: the torso's mass and inertia times 1.2; each shank's length, centre of mass, drawn box and
-inertia about its end for a 10 % longer uniform bar. Both robots walk the default gait from the paper's
+inertia about its end for a 10 % longer uniform bar. Both robots walk the paper's walker from its
 initiation; the table compares them. The same from the command line:
 
     drake-biped walk --model out/own_robot/own_robot.urdf --out out/walk_own

@@ -1,7 +1,7 @@
 """A Poincare return map fitted from walks: section states (hip angle, rate) at each touchdown, x_{n+1} - x* =
 A (x_n - x*) by least squares, and its eigenvalues (the paper's Table VI).
 
-    python examples/return_map.py [--walks 4] [--distance 10] [--t1 0.2 --t2 0.5]
+    python examples/return_map.py [--walks 4] [--distance 10] [--t1 0.1 --t2 0.2]
 
 Each walk starts from a slightly different initiation, so the deviations span both directions.
 """

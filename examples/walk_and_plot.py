@@ -1,4 +1,4 @@
-"""Walk the default gait with a torque-free hip period and plot the hip angles, shading the torque-free time.
+"""Walk the paper's walker with a torque-free hip period and plot the hip angles, shading the torque-free time.
 
     python examples/walk_and_plot.py --out out/example-walk [--distance 10] [--t1 0.2 --t2 0.5]
 """
@@ -16,8 +16,8 @@ from drake_biped.cli import number, run_script, script_parser  # noqa: E402  (th
 
 parser = script_parser(__doc__)
 parser.add_argument("--distance", type=number("positive"), default=10.0, help="walk this far (m)")
-parser.add_argument("--t1", type=number("nonnegative"), default=0.2, help="torque-free start after each step start (s)")
-parser.add_argument("--t2", type=number("nonnegative"), default=0.5, help="torque-free end (s)")
+parser.add_argument("--t1", type=number("nonnegative"), default=0.1, help="torque-free start after each step start (s)")
+parser.add_argument("--t2", type=number("nonnegative"), default=0.2, help="torque-free end (s)")
 parser.add_argument("--out", type=Path, default=Path("out/example-walk"))
 args = parser.parse_args()
 

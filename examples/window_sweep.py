@@ -11,7 +11,7 @@ from drake_biped.cli import number, run_script, script_parser, windows  # the co
 
 parser = script_parser(__doc__)
 parser.add_argument("--distance", type=number("positive"), default=10.0, help="walk this far (m)")
-parser.add_argument("--windows", type=windows, default="0.1-0.4,0.2-0.5,0.3-0.6",
+parser.add_argument("--windows", type=windows, default="0.1-0.2,0.1-0.3,0.5-0.6,0.2-0.5",
                     help="T1-T2 pairs (s, T1 < T2), comma-separated")
 args = parser.parse_args()
 
