@@ -38,6 +38,7 @@ from drake_biped.controller import CpgWalkingController
 from drake_biped.diagram import build_replay_diagram, initial_state
 from drake_biped.episode import run_episode
 from drake_biped.kinematics import center_of_mass
+from drake_biped.model import build_plant
 from drake_biped.params import EpisodeConfig, SimulationParams, TorqueFreeWindow
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
@@ -199,7 +200,9 @@ def python_floor(distance: float, repeats: int, gait: str = "paper") -> dict:
         "plant alone": lambda: None,
         "+ empty Python update": lambda: EmptyUpdate(h),
         "+ the controller's I/O only": lambda: EmptyUpdate(h, io=True),
-        "+ the controller": lambda: CpgWalkingController(config),
+        # the hip motor reads the plant's dynamics (through a context of its own): a plant of the same model
+        "+ the controller": lambda: CpgWalkingController(config, plant=build_plant(
+            config.ground, config.sim.time_step_s, config.model, config.contact)),
     }
     samples: dict[str, list[float]] = {name: [] for name in variants}
     for _ in range(repeats):
