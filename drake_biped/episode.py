@@ -81,7 +81,7 @@ class EpisodeResult:
     # before it was kept
     work_by_role: dict[str, dict[str, float]] | None = None
     # which gait walked (resources.gait_identity): {"name": a shipped gait's or None, "sha256": the walker's digest};
-    # None in a record written before it was kept
+    # found from `config` when the result is recorded (`to_dict`), not on an episode's own path
     gait: dict[str, str | None] | None = None
 
     @property
@@ -109,7 +109,16 @@ class EpisodeResult:
         `fit_return_map` takes."""
         return np.array([[s.hip_angle_rad, s.hip_rate_radps] for s in self.steps], dtype=float).reshape(-1, 2)
 
+    def walked_gait(self) -> dict[str, str | None]:
+        """Which gait walked (`resources.gait_identity` of this result's configuration)."""
+        if self.gait is None:
+            from drake_biped.legacy import config_of_record
+
+            self.gait = gait_identity(config_of_record(self.config, "EpisodeResult.config"))
+        return self.gait
+
     def to_dict(self) -> dict[str, Any]:
+        self.walked_gait()
         d = asdict(self)
         d.pop("trajectory")
         return d
@@ -485,7 +494,6 @@ def run_episode(
         versions=versions(),
         trajectory=trajectory,
         work_by_role=by_role,
-        gait=gait_identity(config),
     )
 
 
