@@ -4,9 +4,9 @@ the ceiling a Python controller can reach.
     python benchmarks/compare_rtf.py BEFORE_TREE AFTER_TREE [--rounds 5] [--episodes 3] [--distance 10]
                                      [--learning 40] [--gait NAME] [--after-gait NAME_OR_FILE]
 
-Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) that walks the default gait (or
-the shipped gait `--gait`, at its own step; the after tree `--after-gait` where given, a name or a parameter
-file its tree reads) `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
+Each round runs, for each tree in turn, a fresh process (PYTHONPATH = the tree) that walks the shipped gait
+`--gait` (default `paper`; named, since trees differ in their default gait) at its own step (the after tree
+`--after-gait` where given, a name or a parameter file its tree reads) `--episodes` times and reports the real-time factor of each walk (simulated time / wall time of
 Simulator.AdvanceTo; the first walk of a process also builds its diagram, which is not timed) and its C_mt.
 In the same round, a process of the after tree measures the ceiling on the same walk: the plant alone
 replaying the walk's logged torques (no Python during the simulation), the same plant stepped by a Python
@@ -34,11 +34,9 @@ HERE = Path(__file__).resolve().parent
 CLOSED_LOOP = """
 import json
 from drake_biped.episode import run_episode
-from drake_biped.params import EpisodeConfig, SimulationParams
 from drake_biped.resources import load_gait
 gait = {gait!r}
-config = (load_gait(gait).override({{"sim.distance_m": {distance}}}) if gait
-          else EpisodeConfig(sim=SimulationParams(distance_m={distance})))
+config = load_gait(gait).override({{"sim.distance_m": {distance}}})
 walks = [run_episode(config) for _ in range({episodes})]
 print(json.dumps({{"rtf": [w.real_time_factor for w in walks], "cmt": [w.cost_of_transport for w in walks]}}))
 """
@@ -50,7 +48,7 @@ import bench
 from drake_biped.episode import run_episode
 from drake_biped.resources import load_gait
 gait = {gait!r}
-config = load_gait(gait).override({{"sim.distance_m": {distance}}}) if gait else bench.config_at(1e-3, {distance})
+config = load_gait(gait).override({{"sim.distance_m": {distance}}})
 ref = run_episode(config, record_trajectory=True)
 times, torques = ref.trajectory["time"], ref.trajectory["actuation"]  # the torques the plant applied
 end = float(times[-1])
@@ -89,8 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--distance", type=float, default=10.0)
     p.add_argument("--learning", type=int, default=0, help="episodes of the learning mix per tree and round (0: none)")
     p.add_argument("--json", type=Path, help="also write every sample here")
-    p.add_argument("--gait", default="", help="a shipped gait to walk at its own step (default: the default gait "
-                   "at 1 ms, as EpisodeConfig() gives it)")
+    p.add_argument("--gait", default="paper", help="the shipped gait to walk, at its own step (default: paper; "
+                   "fast_servo is named default in trees before the paper's walker became the default)")
     p.add_argument("--after-gait", default=None, help="what the after tree walks instead (a shipped name or a "
                    "parameter file), and its ceiling replays: a reading the before tree does not have")
     args = p.parse_args(argv)
@@ -120,8 +118,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"round {r + 1}: " + ", ".join(f"{k} {statistics.median(v):.3f}" for k, v in {**rtf, **ceiling}.items()),
               file=sys.stderr)
     med = {k: statistics.median(v) for k, v in {**rtf, **ceiling}.items()}
-    record = {"trees": {k: str(v) for k, v in trees.items()}, "gait": args.gait or "EpisodeConfig()",
-              "after_gait": after_gait or args.gait or "EpisodeConfig()",
+    record = {"trees": {k: str(v) for k, v in trees.items()}, "gait": args.gait,
+              "after_gait": after_gait,
               "rounds": args.rounds, "episodes": args.episodes,
               "distance_m": args.distance, "closed_loop_rtf": rtf, "cost_of_transport": cmt, "ceiling_rtf": ceiling,
               "learning_episodes_per_min": learning, "median": med,

@@ -21,8 +21,8 @@ from drake_biped.analysis import time_step_report
 from drake_biped.analysis.long_run import LONG_RUN_M, TRANSIENT_M
 from drake_biped.common.executor import dask_client
 from drake_biped.experiments import time_step
-from drake_biped.params import EpisodeConfig
 from drake_biped.records import write_text_atomic
+from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
 # (folder, name, ContactParams fields replaced, contact approximation)
@@ -42,6 +42,8 @@ def window_arg(text: str) -> tuple[float, float]:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--gait", default="fast_servo", help="the shipped gait walked (default: fast_servo, whose learned "
+                   "window is the default --windows; the committed records measured it as the default gait)")
     p.add_argument("--windows", default="0.3672-0.8629", help="comma-separated t1-t2 windows (s)")
     p.add_argument("--steps", default="0.001,0.00025", help="comma-separated plant steps (s)")
     p.add_argument("--distance", type=float, default=TRANSIENT_M + LONG_RUN_M)
@@ -49,7 +51,7 @@ def main() -> None:
     args = p.parse_args()
     windows = [window_arg(w) for w in args.windows.split(",") if w]
     steps = sorted(float(h) for h in args.steps.split(","))
-    base = EpisodeConfig()
+    base = load_gait(args.gait)
     records = []
     with dask_client(workers=args.workers) as client:
         for folder, name, fields, approximation in CONTACTS:
@@ -57,7 +59,7 @@ def main() -> None:
                                   contact=dataclasses.replace(base.contact, **fields))
             t0 = time.perf_counter()
             rec = time_step.study(steps, steps[0], args.distance, client, True, config, windows)
-            rec.update(gait=f"Default gait, contact: {name}", date=time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+            rec.update(gait=f"{args.gait}, contact: {name}", date=time.strftime("%Y-%m-%d %H:%M:%S %Z"),
                        versions=versions(), wall_s=time.perf_counter() - t0)
             (args.out / folder).mkdir(parents=True, exist_ok=True)
             write_text_atomic(args.out / folder / "time_step_study.json", json.dumps(rec, indent=2) + "\n")
