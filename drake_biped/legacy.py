@@ -16,7 +16,11 @@ from typing import Any
 
 from drake_biped.params import DRAKE_DEFAULT_CONTACT, EpisodeConfig, SimulationParams
 
-__all__ = ["RECORD_BASE", "clock_of_record", "config_of_record"]
+__all__ = ["RECORD_BASE", "STUDY_WALKS_BEFORE_RECORDED", "clock_of_record", "config_of_record"]
+
+# The walks of a time-step study whose record does not list them (written before it did): none, the then default
+# gait's learned window and one early in its swing.
+STUDY_WALKS_BEFORE_RECORDED = [None, (0.3672, 0.8629), (0.3, 0.6)]
 
 # The sections a record's missing fields are read from (frozen: a record's walk must not move when a default does).
 RECORD_BASE = EpisodeConfig.from_dict({

@@ -143,3 +143,33 @@ def test_walks_too_short_for_a_long_run_mean_compare_the_whole_walk_and_say_so(m
     assert "C_mt is the whole walk's" in text and "the long-run mean after" not in text
     assert "0.6010 (0.0 %)" in text and "0.6020 (+0.2 %)" in text
     assert "Not computed: it needs three finest steps that halve" in text
+
+
+def test_a_study_compares_the_walked_gaits_own_window_and_names_the_gait(tmp_path, capsys, monkeypatch):
+    """Without --windows, `--params NAME` compares that gait's own window (its file's), printed with the gait;
+    without --params, the paper walker's two (WALKS). A record written before the walks were recorded is read
+    with the walks it walked then (none, 0.3672-0.8629 s and 0.3-0.6 s)."""
+    import json
+
+    from drake_biped.cli import build_parser
+    from drake_biped.experiments import time_step
+    from drake_biped.resources import gait_compare_window
+
+    def settings(*argv):
+        return time_step.settings_from_args(build_parser().parse_args(["time-step-study", *argv, "--out",
+                                                                        str(tmp_path / "t")]))
+
+    fast = settings("--params", "fast_servo")
+    gait, window = capsys.readouterr().out.splitlines()
+    assert gait.startswith("gait: fast_servo (sha256 ") and window.startswith("window 0.3672-0.8629 s:")
+    assert fast.windows == (gait_compare_window("fast_servo")[0],)
+    assert settings().windows is None and time_step.WALKS == [None, (0.1, 0.2), (0.5, 0.6)]
+    assert capsys.readouterr().out.startswith("gait: paper (sha256 ")
+    # a record from before the walks were recorded: its report is drawn with the walks it walked
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "time_step_study.json").write_text(json.dumps({"steps": [], "rows": [], "reference_s": 1e-3}))
+    drawn = []
+    monkeypatch.setattr(time_step, "markdown", lambda rec: drawn.append(rec["walks"]) or "")
+    monkeypatch.setattr(time_step, "figure", lambda rec, path: None)
+    time_step.replot(tmp_path / "old")
+    assert drawn == [[None, (0.3672, 0.8629), (0.3, 0.6)]]

@@ -1,7 +1,7 @@
 """Time-step study: the convergence of a gait's long-run cost of transport as the plant step is halved.
 
-Each walk (no window and each window given; by default the default gait's learned window and a window early
-in the swing) goes LONG_WALK_M from the paper's initiation at every plant step. The controller's clock is the
+Each walk (no window and each window given; by default the gait's own window, the one its file declares, and
+on the paper's walker one late in its step) goes LONG_WALK_M from the paper's initiation at every plant step. The controller's clock is the
 gait's: under the paper's reading (the controller acts at every plant step) plant and controller are refined
 together; a fixed-rate loop (`--control-period`) is part of the robot and kept, the plant step alone refined
 under it (steps that do not divide it are refused). A walk's C_mt is
@@ -33,14 +33,17 @@ from drake_biped.common.options import (
     add_model_option,
     check_walks,
     cluster,
+    default_window,
+    gait_line,
     number,
     out_folder,
     steps,
+    window_line,
     windows,
     with_clock,
     with_model,
 )
-from drake_biped.legacy import clock_of_record
+from drake_biped.legacy import STUDY_WALKS_BEFORE_RECORDED, clock_of_record
 from drake_biped.params import (
     DEFAULT_WINDOW_S,
     GRAVITY_MPS2,
@@ -261,7 +264,7 @@ def replot(out: Path) -> dict:
     missing = [k for k in ("steps", "rows", "reference_s") if not isinstance(rec, dict) or k not in rec]
     if missing:
         raise ParameterError(f"--replot {out / 'time_step_study.json'}: not a time-step study (no {missing[0]!r})")
-    rec.setdefault("walks", WALKS)  # records written before walks were recorded walked WALKS
+    rec.setdefault("walks", STUDY_WALKS_BEFORE_RECORDED)
     write_text_atomic(out / "time_step_study.md", markdown(rec))
     figure(rec, out / "time_step_study.png")
     return rec
@@ -284,12 +287,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="walk this far (m); default 110: the first 10 m are the transient, the long-run C_mt is "
                    "over the rest")
     p.add_argument("--params", help="the gait (a shipped gait's name or a JSON file, as elsewhere); default: the "
-                   "default gait. Its own time step is replaced by each of --steps")
+                   "paper's walker. Its own time step is replaced by each of --steps")
     add_model_option(p)
     add_clock_option(p)
     p.add_argument("--windows", type=windows,
-                   help="the windows compared with none, T1-T2 in s, comma-separated (default "
-                   "0.3672-0.8629,0.3-0.6: the default gait's learned window and one early in the swing)")
+                   help="the windows compared with none, T1-T2 in s, comma-separated (default: the gait's own, the "
+                   "one its file declares; without --params the paper walker's 0.1-0.2 and 0.5-0.6, late in its step)")
     p.add_argument("--measure", choices=MEASURES, default="long-run",
                    help="what is compared at each step: the long-run mean after the first 10 m (walks of 110 m or "
                    "more), or the whole walk's C_mt ('episode', any distance)")
@@ -312,10 +315,15 @@ def settings_from_args(args: argparse.Namespace) -> TimeStepSettings:
         period = (config or EpisodeConfig()).sim.control_period_s
         chosen = [h for h in STEPS if period is None or abs(period / h - round(period / h)) <= 1e-6]
     reference = min(chosen) if args.reference is None else args.reference
+    print(gait_line(config or EpisodeConfig()))
+    compared = None if args.windows is None else tuple(args.windows)
+    if compared is None and args.params is not None:  # the gait's own window, never another gait's
+        window, source = default_window(config, args.params)
+        print(window_line(window, source))
+        compared = (window,)
     return TimeStepSettings(tuple(chosen), reference, args.distance, config,
-                            "Default gait" if args.params is None else f"Gait {args.params}",
-                            None if args.windows is None else tuple(args.windows), force=args.force,
-                            measure=args.measure)
+                            "The paper's walker" if args.params is None else f"Gait {args.params}",
+                            compared, force=args.force, measure=args.measure)
 
 
 def command(args: argparse.Namespace) -> int:
