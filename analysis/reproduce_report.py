@@ -145,6 +145,30 @@ def walk_section(walk: dict[str, Any], gait: str = "paper") -> list[str]:
         "",
         "![walk](walk/walk.png)",
         "",
+        *energy_section(walk.get("energy")),
+    ]
+
+
+def energy_section(energy: dict[str, Any] | None) -> list[str]:
+    """Where the walk's energy goes (`walk/energy.json`, written by `drake-biped walk`), its initiation left out;
+    nothing for a walk recorded before the audit was kept, or one too short to leave its initiation."""
+    if not energy:
+        return []
+    by_role, shares = energy["work_by_role"], energy["shares"]
+    rows = [f"| {role.replace('_', ' ')} | {v['positive_j']:.1f} | {v['negative_j']:.1f} | {100 * shares[role]:.0f} % |"
+            for role, v in by_role.items()]
+    return [
+        f"Where its energy goes: the motors' work by the joints' roles from the first touchdown after "
+        f"{energy['from_s']:g} s (the initiation left out), each control period counted for the roles held when "
+        f"it began. The torque-free window frees only the swing hip, which does "
+        f"**{100 * shares['swing_hip']:.0f} %** of the positive work here.",
+        "",
+        "| role | positive work (J) | negative work (J) | share of the positive work |",
+        "|---|---|---|---|",
+        *rows,
+        "",
+        "![energy by role](walk/energy.png)",
+        "",
     ]
 
 

@@ -77,3 +77,33 @@ def test_the_energy_figure_draws_the_work_it_is_given(tmp_path, monkeypatch):
     heights = [p.get_height() for p in drawn[0].axes[0].patches]
     assert heights[:6] == pytest.approx([by_role[r]["positive_j"] for r in ROLES])
     assert heights[6:] == pytest.approx([by_role[r]["negative_j"] for r in ROLES])
+
+
+def test_a_walk_writes_its_energy_audit_and_the_report_shows_the_swing_hips_share(tmp_path):
+    """`drake-biped walk` (walk.write_walk) writes energy.json and energy.png from its recorded walk, the
+    initiation left out: the shares are those of the trajectory's own role sums, and the report's walk section
+    gives the swing hip's share; a walk that ends inside the initiation writes no audit."""
+    import json
+
+    from walkers import FAST
+
+    from drake_biped.analysis.reproduce_report import energy_section
+    from drake_biped.experiments.walk import energy_line, write_energy, write_walk
+
+    result = write_walk(FAST.override({"sim.distance_m": 6.0}), tmp_path / "w", animation=False)
+    record = json.loads((tmp_path / "w" / "energy.json").read_text())
+    assert record["from_s"] == 3.0 and (tmp_path / "w" / "energy.png").stat().st_size > 10_000
+    again = work_by_role(result.trajectory)
+    for role in ROLES:
+        assert record["work_by_role"][role] == pytest.approx(again[role], rel=1e-12)
+    assert record["shares"] == pytest.approx(shares(again), rel=1e-12)
+    assert sum(record["shares"].values()) == pytest.approx(1.0)
+    # the audit past the initiation is less than the whole walk's, role by role
+    assert all(record["work_by_role"][r]["positive_j"] <= result.work_by_role[r]["positive_j"] + 1e-9 for r in ROLES)
+    hip = record["shares"]["swing_hip"]
+    assert f"swing hip {100 * hip:.0f} %" in energy_line(record)
+    assert f"does **{100 * hip:.0f} %** of the positive work" in "\n".join(energy_section(record))
+    assert energy_section(None) == [] and energy_line(None) is None
+    short = write_walk(FAST.override({"sim.distance_m": 1.0}), tmp_path / "s", animation=False)
+    assert short.duration_s < 3.0 and write_energy(short.trajectory, tmp_path / "s") is None
+    assert not (tmp_path / "s" / "energy.json").exists()

@@ -176,7 +176,7 @@ class Reproduction:
             r = walk.run(walk.WalkSettings(self.level), folder, progress=False)
             return {"distance_m": r.distance_m, "fell": r.fell, "cost_of_transport": r.cost_of_transport,
                     "mean_speed_mps": r.mean_speed_mps, "step_period_s": r.step_period_s,
-                    "real_time_factor": r.real_time_factor}
+                    "real_time_factor": r.real_time_factor, "energy": read_kept(folder / "energy.json")}
 
         return self.experiment("walk", {"distance_m": self.profile.distance_m}, run)
 

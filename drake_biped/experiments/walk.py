@@ -35,7 +35,7 @@ from drake_biped.params import (
     check_window_given,
     walked_the_distance,
 )
-from drake_biped.records import warn, write_text_atomic
+from drake_biped.records import read_kept, warn, write_atomic, write_text_atomic
 
 
 class GraphvizMissingError(RuntimeError):
@@ -269,6 +269,7 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
         f"C_mt {format_cost(result.cost_of_transport)}"
     ) + (f", torque-free {window.start_s:g}-{window.end_s:g} s" if window.active else ", no torque-free window")
     walk_figure(result.trajectory, out / "walk.png", title=title)
+    write_energy(result.trajectory, out, title)
     if meshcat is not None:
         write_meshcat_html(meshcat, out / "walk.html", follow=(result.trajectory["time"],
                                                              result.trajectory["positions"][:, 0]),
@@ -278,6 +279,38 @@ def write_walk(config: EpisodeConfig, out: Path, animation: bool = True, save_tr
         walk_animation(result.trajectory, out / "walk.gif", ground_height=config.ground.height,
                        body=body_of_model(config.model))
     return result
+
+
+def write_energy(trajectory, out: Path, title: str = "") -> dict | None:
+    """Where the walk's energy goes, its initiation left out (`analysis.energy`: from the first touchdown at or
+    after INITIATION_S): out/energy.json ({"from_s", "work_by_role", "shares"}) and out/energy.png (work by role,
+    power over the time since touchdown). None, and nothing written, for a walk with no touchdown after it."""
+    from drake_biped.analysis import energy
+
+    try:
+        by_role = energy.work_by_role(trajectory)
+        shares = energy.shares(by_role)
+    except ValueError:
+        return None
+    record = {"from_s": energy.INITIATION_S, "work_by_role": by_role, "shares": shares}
+    write_atomic(out / "energy.json", record)
+    energy.energy_figure(by_role, energy.power_by_phase(trajectory), out / "energy.png",
+                         title=f"the motors' work by role after the first {energy.INITIATION_S:g} s"
+                         + (f" ({title})" if title else ""))
+    return record
+
+
+def energy_line(record: dict | None) -> str | None:
+    """The energy audit in a line: each role's share of the positive work after the initiation, the swing hip's
+    braking beside it. None without an audit."""
+    if not record:
+        return None
+    by_role, shares = record["work_by_role"], record["shares"]
+    parts = [f"{role.replace('_', ' ')} {100 * share:.0f} %" for role, share in
+             sorted(shares.items(), key=lambda kv: -kv[1]) if share >= 0.005]
+    hip = by_role["swing_hip"]
+    return (f"positive work by role after the first {record['from_s']:g} s: {', '.join(parts)}; the swing hip "
+            f"{hip['positive_j']:.1f} J driving, {hip['negative_j']:.1f} J braking (energy.json, energy.png)")
 
 
 COMMAND = "walk"
@@ -324,6 +357,9 @@ def command(args: argparse.Namespace) -> int:
     out = Path(args.out)
     result = run(settings, out)
     print_lines(summary_lines(result))
+    line = energy_line(read_kept(out / "energy.json"))
+    if line is not None:
+        print(line)
     print_lines(record_comparison_lines(args.params, config, result))
     note = mass_note(result.mass_kg)
     if note is not None:
