@@ -41,6 +41,28 @@ def test_replaying_the_logged_torques_retraces_the_closed_loop(short_walk):
         np.testing.assert_allclose(plant.GetPositions(context), T["positions"][i], rtol=0, atol=1e-9)
 
 
+def test_the_benchmarks_plant_timer_counts_every_plant_step_and_changes_nothing():
+    """benchmarks/bench.py's plant share within the closed loop (its measure where a replay cannot retrace,
+    the plant's hip motors): it times each of the episode's plant steps, the walk is the untimed walk to
+    the last digit, and the plant's class is as it was afterwards."""
+    import importlib.util
+    from pathlib import Path
+
+    from pydrake.multibody.plant import MultibodyPlant
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench.py"
+    spec = importlib.util.spec_from_file_location("bench_under_test", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    config = fast_config(sim=SimulationParams(distance_m=0.5, max_time_s=5.0))
+    plain = run_episode(config)
+    in_plant, loop, steps, cost = bench.plant_share_in_loop(config)
+    assert "ExecuteForcedEvents" not in MultibodyPlant.__dict__
+    assert steps == round(plain.duration_s / config.sim.time_step_s)
+    assert cost == plain.cost_of_transport
+    assert 0.0 < in_plant < loop
+
+
 def test_replay_rejects_a_malformed_log():
     with pytest.raises(ValueError, match="torques"):
         build_replay_diagram(_config(), np.arange(3) * 1e-3, np.zeros((3, 5)))
