@@ -369,3 +369,58 @@ def test_converged_objective_scores_the_spread_and_the_chatter_at_the_walks_own_
         value, detail = objectives.score(config, objective="converged")
         assert value == pytest.approx(expected, abs=0.01), (robust, spread, changes, moved, detail)
     assert objectives.OBJECTIVES["converged"].maximum == 0.0
+
+
+def test_calibrated_objective_asks_the_papers_step_and_cmt_once_converged(monkeypatch):
+    """Fake walks: a converged walker (its "converged" score 0) scores 0 when its long-run step period is within
+    10 % of 1.0 s and its long-run C_mt within 10 % of Table V's 0.58; 1.3 s steps (30 % off: two tolerances past)
+    and C_mt 0.213 (63 % off) each cost 1/5; a walker whose converged score is v < 0 keeps 3 v / 5; one whose
+    robust checks fail ranks below every one that holds."""
+    config = fast_config(sim=SimulationParams(distance_m=100.0))
+    cases = ((0.0, 1.05, 0.60, 0.0), (0.0, 1.3, 0.60, -0.2), (0.0, 1.3, 0.213, -0.4), (0.0, 0.95, 0.55, 0.0),
+             (-0.5, 1.0, 0.58, -0.3), (0.0, 1.15, 0.58, -0.1))
+    for converged, period, cost, expected in cases:
+        base = {"walked": True, "cost_of_transport": cost, "distance_m": 100.0, "reward": 1 / cost,
+                "step_period_std_s": 1e-3, "step_period_mean_s": period, "long_run_cost_of_transport": cost}
+        monkeypatch.setattr(objectives, "_walk", lambda c, base=base: base)
+        monkeypatch.setattr(objectives, "_converged_score",
+                            lambda c, b, v=converged: (v, {"converged": {}, "checks": {}}))
+        value, detail = objectives.score(config, objective="calibrated")
+        assert value == pytest.approx(expected, abs=1e-9), (period, cost, detail)
+    monkeypatch.setattr(objectives, "_converged_score", lambda c, b: (-2.1, {"checks": {}}))
+    assert objectives.score(config, objective="calibrated")[0] < -1.0
+    assert objectives.OBJECTIVES["calibrated"].maximum == 0.0
+
+
+def test_halving_objective_walks_windows_placed_by_the_step_only_where_the_swing_hip_works(monkeypatch):
+    """Fake walks with 0.8 s steps: a walker whose swing hip does 20 % of the work walks no window and scores
+    0.2 - 1; one doing 60 % walks HALVING_WINDOWS at fractions of its own 0.8 s step, and scores the best
+    long-run saving (a window ending at touchdown halves C_mt) plus 0.01 per window that walks; a window that
+    falls is no saving."""
+    config = fast_config(sim=SimulationParams(distance_m=100.0))
+    walked = []
+
+    def walk(c, share):
+        w = c.window
+        if w.active:
+            walked.append((w.start_s, w.end_s))
+        cost = 0.4
+        if w.active and abs(w.end_s - 0.8) < 1e-9:
+            cost = 0.2
+        falls = w.active and w.end_s > 0.9
+        return {"walked": not falls, "cost_of_transport": cost, "distance_m": 50.0 if falls else 100.0,
+                "reward": 1 / cost, "step_period_std_s": 1e-3, "step_period_mean_s": 0.8,
+                "long_run_cost_of_transport": cost, "swing_hip_share": share}
+
+    monkeypatch.setattr(objectives, "_robust_score", lambda c, b: (0.0, {"checks": {}}))
+    monkeypatch.setattr(objectives, "_walk", lambda c: walk(c, 0.2))
+    value, detail = objectives.score(config, objective="halving")
+    assert value == pytest.approx(0.2 - 1.0) and walked == [] and detail["swing_hip_share"] == 0.2
+    monkeypatch.setattr(objectives, "_walk", lambda c: walk(c, 0.6))
+    value, detail = objectives.score(config, objective="halving")
+    expected = [(round(a * 0.8, 4), round(b * 0.8, 4)) for a, b in objectives.HALVING_WINDOWS]
+    assert walked == expected
+    assert detail["best_saving"] == pytest.approx(0.5)
+    assert value == pytest.approx(0.5 + 0.01 * (len(expected) - 1))  # the window to 1.2 x the step falls
+    monkeypatch.setattr(objectives, "_robust_score", lambda c, b: (-0.4, {"checks": {}}))
+    assert objectives.score(config, objective="halving")[0] == pytest.approx(-2.4)

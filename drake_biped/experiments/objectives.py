@@ -33,6 +33,18 @@ ROBUST_CMT_CHANGE = 0.02
 # the half step's relative C_mt change (the robust objective allows ROBUST_CMT_CHANGE).
 CONVERGED_STEP_SD_S, CONVERGED_SIGN_CHANGES, CONVERGED_AFTER_S = 1e-3, 20.0, 3.0
 CONVERGED_CMT_CHANGE = 0.005
+# The "calibrated" objective's targets, what the paper prints of its walker without the window: its step period
+# (the learner starts both times at 0.5 s, "half of the walking cycle": a cycle of the swing hip's control, from
+# one step's start to the next, of 1.0 s) and Table V's C_mt without the torque-free period (0.58, read as the
+# dimensionless C_mt, as Table V's ASIMO 1.60 and human 0.05 are); each met within CALIBRATION_TOLERANCE of it.
+PAPER_STEP_PERIOD_S = 2.0 * 0.5
+CALIBRATION_TOLERANCE = 0.1
+# The "halving" objective: the windows it walks, as fractions (t1, t2) of the walk's own step period (the hip off
+# from early, middle and late in the swing, to the step's end and on through touchdown), and the swing hip's share
+# of the positive work below which no window is walked (freeing a hip that does less than a quarter of the work
+# cannot halve C_mt unless it changes the whole gait; the screen costs nothing beyond the walk without a window).
+HALVING_WINDOWS = ((0.1, 0.5), (0.3, 0.7), (0.5, 0.9), (0.2, 1.0), (0.4, 1.0), (0.6, 1.2))
+HALVING_SCREEN_SHARE = 0.25
 # The "hold" objective's windows (t1 across the end of the step, t2 past any step) and how far below the best
 # window's reward gain a window still lies within the learner's reach.
 HOLD_WINDOWS = tuple((round(0.30 + 0.02 * i, 2), 1.2) for i in range(14))
@@ -68,14 +80,21 @@ def _walk(config: EpisodeConfig) -> dict[str, Any]:
 
     r = run_episode(config)
     walked = walked_the_distance(r.fell, r.distance_m, config.sim.distance_m)
-    # the step period's spread after the initiation's transient, where the walk is long enough to have one
-    long = walked and config.sim.distance_m >= 2 * TRANSIENT_M
+    # the long-run figures after the initiation's transient, where the walk is long enough to have them
+    long = r.long_run() if walked and config.sim.distance_m >= 2 * TRANSIENT_M else {}
+    positive = {role: w["positive_j"] for role, w in (r.work_by_role or {}).items()}
+    total = sum(positive.values())
     return {
         "walked": walked,
         "cost_of_transport": r.cost_of_transport,
         "distance_m": r.distance_m,
         "reward": reward(r.cost_of_transport, r.distance_m, config.sim.distance_m),
-        "step_period_std_s": r.long_run()["step_period_std_s"] if long else None,
+        "step_period_std_s": long.get("step_period_std_s"),
+        "step_period_mean_s": long.get("step_period_mean_s"),
+        "long_run_cost_of_transport": long.get("cost_of_transport"),
+        # the swing hip's share of the motors' positive work over the whole walk (its initiation a few per cent
+        # of a 100 m walk's)
+        "swing_hip_share": positive.get("swing_hip", 0.0) / total if total > 0.0 else None,
     }
 
 
@@ -150,6 +169,47 @@ def _converged_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
               + excess(moved, CONVERGED_CMT_CHANGE)) / 3.0
     detail["converged"] = {"step_period_std_s": spread, "sign_changes_per_s": changes, "half_step_cmt_change": moved}
     return value, detail
+
+
+def _excess(value: float, target: float, tolerance: float) -> float:
+    """How far `value` lies outside `target` +- `tolerance` (relative), in units of the tolerance, capped at 1."""
+    return min(1.0, max(0.0, abs(value / target - 1.0) / tolerance - 1.0))
+
+
+def _calibrated_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "calibrated" objective (module docstring) and what it measured; `base` may be a fall."""
+    value, detail = _converged_score(config, base)
+    if "converged" not in detail:  # a robust check failed, or the walk was too short to judge
+        return value - 1.0, detail
+    period, cost = base["step_period_mean_s"], base["long_run_cost_of_transport"]
+    from drake_biped.paper import TABLE_V
+
+    target = TABLE_V["CPG without torque-free period"]
+    p = _excess(period, PAPER_STEP_PERIOD_S, CALIBRATION_TOLERANCE)
+    c = _excess(cost, target, CALIBRATION_TOLERANCE)
+    detail["calibration"] = {"step_period_mean_s": period, "long_run_cost_of_transport": cost,
+                             "step_period_excess": p, "cost_excess": c, "converged_score": value}
+    return (3.0 * value - p - c) / 5.0, detail
+
+
+def _halving_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
+    """The "halving" objective (module docstring) and what it measured; `base` may be a fall."""
+    robust, detail = _robust_score(config, base)
+    if robust < 0.0 or base.get("long_run_cost_of_transport") is None:
+        return robust - 2.0, detail
+    share = base["swing_hip_share"] or 0.0
+    detail["swing_hip_share"] = share
+    if share < HALVING_SCREEN_SHARE:
+        return share - 1.0, detail
+    period = base["step_period_mean_s"]
+    windows = [(round(a * period, 4), round(b * period, 4)) for a, b in HALVING_WINDOWS]
+    rows = _window_rows(config, windows, base)
+    for row in rows:
+        cost = row.get("long_run_cost_of_transport")
+        row["saving"] = (1.0 - cost / base["long_run_cost_of_transport"]) if row["walked"] and cost else None
+    savings = [r["saving"] for r in rows if r["saving"] is not None]
+    best = max(savings) if savings else -0.5
+    return max(-0.5, best) + 0.01 * len(savings), {**detail, "windows": rows, "best_saving": best}
 
 
 def _story_score(config: EpisodeConfig, base: dict[str, Any], draws: int) -> tuple[float, dict[str, Any]]:
@@ -278,6 +338,8 @@ OBJECTIVES: dict[str, Objective] = {
     "nearest": Objective(_nearest_score, False, '-(d / (1 + d) + f) / 3, d the CPG\'s distance from Table III (`distance_from_table_iii`) and f how many of the +-PUSH_FORCE_N pushes (stability\'s, without a window) the gait does not walk through, to find the walker whose CPG is nearest the paper\'s (with the "near_paper" mutations); in (-1, 0], so any walker, however far, beats every fall, and one that survives both pushes beats every one that does not (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push).'),
     "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold.", 0.0),
     "converged": Objective(_of_base(_converged_score), True, 'The "robust" objective first (while a check fails, its score - 2), then how far the walk is from converged at its own plant step: -(s + c + m) / 3, s the excess of the step period\'s sd (the walk without a window, after the first 10 m) over CONVERGED_STEP_SD_S, c that of the swing hip\'s sign changes per second (a 10 m walk after CONVERGED_AFTER_S) over CONVERGED_SIGN_CHANGES and m that of the half step\'s relative C_mt change over CONVERGED_CMT_CHANGE, each in units of its target and capped at 1; in [-1, 0] once all hold, 0 when all three are met.', 0.0),
+    "calibrated": Objective(_of_base(_calibrated_score), True, 'The "converged" objective, then how far the walk without a window is from what the paper prints of its walker: (3 v - p - c) / 5, v the "converged" score, p the excess of the long-run step period\'s relative distance from PAPER_STEP_PERIOD_S (the learner\'s start, 0.5 s, is "half of the walking cycle") over CALIBRATION_TOLERANCE and c that of the long-run C_mt\'s from Table V\'s 0.58 without the window, each in units of the tolerance and capped at 1; while a robust check fails, the "converged" score - 1; in [-1, 0] once all robust checks hold, 0 when the converged targets and both of the paper\'s figures are met.', 0.0),
+    "halving": Objective(_of_base(_halving_score), True, 'The "robust" objective first (while a check fails, its score - 2), then the largest long-run C_mt saving among windows placed by the walk\'s own step period (HALVING_WINDOWS, fractions of it, walked over the search\'s distance), +0.01 for each window that walks (-0.5 when none saves more or none walks); a walker whose swing hip does less than HALVING_SCREEN_SHARE of the positive work without the window walks no window and scores its share - 1 (below any walker whose windows were walked).'),
     "story": Objective(_of_draws(_story_score), True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
     "hold": Objective(_of_base(_hold_score), True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
 }
