@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
+from drake_biped.analysis.energy_report import energy_section, energy_walks_section
 from drake_biped.analysis.dynamics_report import (
     dynamics_rows,
     dynamics_section,
@@ -133,7 +134,7 @@ def gait_label(gait: str) -> str:
     return f"the `{gait}` gait"
 
 
-def walk_section(walk: dict[str, Any], gait: str = "paper") -> list[str]:
+def walk_section(walk: dict[str, Any], gait: str = "paper", energy_walks: dict[str, Any] | None = None) -> list[str]:
     """The report's section on the gait's walk (`walk/`), from its summary."""
     return [
         "## The walk (`walk/`)",
@@ -146,29 +147,7 @@ def walk_section(walk: dict[str, Any], gait: str = "paper") -> list[str]:
         "![walk](walk/walk.png)",
         "",
         *energy_section(walk.get("energy")),
-    ]
-
-
-def energy_section(energy: dict[str, Any] | None) -> list[str]:
-    """Where the walk's energy goes (`walk/energy.json`, written by `drake-biped walk`), its initiation left out;
-    nothing for a walk recorded before the audit was kept, or one too short to leave its initiation."""
-    if not energy:
-        return []
-    by_role, shares = energy["work_by_role"], energy["shares"]
-    rows = [f"| {role.replace('_', ' ')} | {v['positive_j']:.1f} | {v['negative_j']:.1f} | {100 * shares[role]:.0f} % |"
-            for role, v in by_role.items()]
-    return [
-        f"Where its energy goes: the motors' work by the joints' roles from the first touchdown after "
-        f"{energy['from_s']:g} s (the initiation left out), each control period counted for the roles held when "
-        f"it began. The torque-free window frees only the swing hip, which does "
-        f"**{100 * shares['swing_hip']:.0f} %** of the positive work here.",
-        "",
-        "| role | positive work (J) | negative work (J) | share of the positive work |",
-        "|---|---|---|---|",
-        *rows,
-        "",
-        "![energy by role](walk/energy.png)",
-        "",
+        *energy_walks_section(walk, energy_walks),
     ]
 
 
@@ -257,7 +236,7 @@ def report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any, code:
         "",
         "![verdicts](report_summary.png)",
         "",
-        *walk_section(walk, gait),
+        *walk_section(walk, gait, s.get("energy")),
         "## Grid search, Table IV (`grid/`)",
         "",
         f"{grid['points']} points over Table IV's CPG ranges and the initiation, level ground, one episode each: "
@@ -639,7 +618,7 @@ def quick_report_markdown(out: Path, s: dict[str, dict[str, Any]], profile: Any,
         "",
         "![verdicts](report_summary.png)",
         "",
-        *walk_section(walk, gait),
+        *walk_section(walk, gait, s.get("energy")),
     ]
     if fr:
         lines += ["## The full run's learned windows, walked again here (`full_run/`)", "",

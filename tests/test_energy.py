@@ -87,7 +87,7 @@ def test_a_walk_writes_its_energy_audit_and_the_report_shows_the_swing_hips_shar
 
     from walkers import FAST
 
-    from drake_biped.analysis.reproduce_report import energy_section
+    from drake_biped.analysis.energy_report import energy_section
     from drake_biped.experiments.walk import energy_line, write_energy, write_walk
 
     result = write_walk(FAST.override({"sim.distance_m": 6.0}), tmp_path / "w", animation=False)
@@ -107,3 +107,31 @@ def test_a_walk_writes_its_energy_audit_and_the_report_shows_the_swing_hips_shar
     short = write_walk(FAST.override({"sim.distance_m": 1.0}), tmp_path / "s", animation=False)
     assert short.duration_s < 3.0 and write_energy(short.trajectory, tmp_path / "s") is None
     assert not (tmp_path / "s" / "energy.json").exists()
+
+
+def test_the_reports_energy_table_gives_each_walks_shares_beside_the_story_walkers():
+    """The reproduction's energy step: each walk's row holds its C_mt, its positive work after the initiation and
+    each role's share of it, in model.ROLES order, below the story walker's own row; a walk too short for an
+    audit keeps its row, without shares, and no figure."""
+    from drake_biped.analysis.energy_report import energy_walks_section
+
+    def audit(swing_hip):
+        work = {role: {"positive_j": 10.0, "negative_j": -1.0} for role in ROLES}
+        work["swing_hip"]["positive_j"] = swing_hip
+        total = sum(v["positive_j"] for v in work.values())
+        return {"from_s": 3.0, "work_by_role": work, "shares": {r: v["positive_j"] / total for r, v in work.items()}}
+
+    walk = {"cost_of_transport": 0.2194, "energy": audit(10.0)}
+    walks = {"gait": "paper", "distance_m": 10.0, "walks": {
+        "window": {"label": "paper, window 0.1-0.2 s (learned)", "cost_of_transport": 0.2055, "fell": False,
+                   "distance_m": 10.0, "energy": audit(50.0)},
+        "fast_servo": {"label": "fast_servo, no window", "cost_of_transport": 0.55, "fell": True,
+                       "distance_m": 1.2, "energy": None}}}
+    text = "\n".join(energy_walks_section(walk, walks))
+    rows = [line for line in text.splitlines() if line.startswith("| paper") or line.startswith("| fast_servo")]
+    assert rows[0] == "| paper, no window (the walk above) | 0.2194 | 60 J | " + " | ".join(["17 %"] * 6) + " |"
+    shares = [f"{100 * (50 if role == 'swing_hip' else 10) / 100:.0f} %" for role in ROLES]
+    assert rows[1] == "| paper, window 0.1-0.2 s (learned) | 0.2055 | 100 J | " + " | ".join(shares) + " |"
+    assert rows[2].startswith("| fast_servo, no window (fell at 1.2 m) | 0.5500 | — |")
+    assert "(energy/window/energy.png)" in text and "energy/fast_servo/" not in text
+    assert energy_walks_section(walk, None) == []

@@ -51,6 +51,7 @@ LAYERS = {
     "drake_biped.analysis.push_margin_report": RECORDS,
     "drake_biped.analysis.floquet_report": RECORDS,
     "drake_biped.analysis.energy": RECORDS,
+    "drake_biped.analysis.energy_report": RECORDS,
     "drake_biped.analysis.reproduce_report": RECORDS,
     "drake_biped.analysis.dynamics_report": RECORDS,
     "drake_biped.analysis.report_figures": RECORDS,

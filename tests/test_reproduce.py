@@ -129,8 +129,11 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for figure in ("report_summary.png", "walk/walk.png", "learn/fig4_reward.png", "stability/fig7_return_map.png",
                    "compare_learners/compare.png", "floquet/none/floquet.png", "slope/fig8_period.png",
                    "slope2deg/fig9_distance.png", "grid/grid_slices.png", "dynamics/t1/bifurcation.png",
-                   "dynamics/basins/basins.png"):
+                   "dynamics/basins/basins.png", "walk/energy.png", "energy/window/energy.png",
+                   "energy/paper_window/energy.png"):
         assert f"({figure})" in text and (tmp_path / figure).is_file(), figure
+    # the energy audit with the learned window and on the other shipped gait, without and with its window
+    assert "| fast_servo, no window (the walk above) |" in text and "| paper, no window |" in text
     # The Floquet row says of each orbit whether its multipliers establish anything.
     from drake_biped.analysis.floquet import record_verdict
 
@@ -435,6 +438,8 @@ def test_the_committed_full_runs_report_reads_its_own_gait_in_every_section(monk
     if not out.is_dir():
         pytest.skip("not a checkout")
     summaries = {step: read_kept(out / step / "summary.json") for step in steps_of(FULL, gait)}
+    # steps added since the run was measured (the energy audit's walks) are not in its records
+    summaries = {step: summary for step, summary in summaries.items() if summary is not None or step != "energy"}
     monkeypatch.setattr(reproduce_report, "summary_figure", lambda *a, **k: None)  # the records stay as committed
     text, verdicts = report_markdown(out, summaries, FULL, {}, gait, STORIES[gait].why)
     name = f"the `{gait}` gait"

@@ -9,6 +9,8 @@ functions as its own command:
     window_map/      the gait's torque-free windows against none
     learn/           Experiment 1 with the paper's settings (Table V, Figs. 4-6)
     learn_variant/   the same with exploration matched to the gait (the story's start; variance 0.01)
+    energy/          where the energy goes with the learned window, and on the other shipped gait without and
+                     with its own window (the walk's audit is walk/energy.json)
     time_step/       the time-step study: no window, the learned window and the story's second window
     stability/       pushes and return maps, none vs the learned window (Table VI, Fig. 7)
     push_margin/     the largest pushes survived, none vs the learned window
@@ -81,6 +83,10 @@ SLOPE_2DEG_RAD_PRINTED = 0.0349  # 2.0 deg to 4 digits, as the slope runs record
 SLOPE_2DEG_CPG_SCALE = 1.25
 SLOPE_2DEG_LEANS = (0.0, 0.04, 0.08, 0.12)
 SLOPE_2DEG_PLACEMENT = 0.1
+
+
+def _window_label(window: tuple[float, float]) -> str:
+    return f"window {window[0]:g}-{window[1]:g} s" if window[1] > window[0] else "no window"
 
 
 class Reproduction:
@@ -355,6 +361,38 @@ class Reproduction:
     def learn_variant(self) -> dict:
         trials, episodes = self.profile.learn_variant
         return self._learn("learn_variant", trials, episodes, self.story.variant_start, self.story.variant_variance)
+
+    def energy(self) -> dict:
+        """Where the energy goes with the story's window, and on the other shipped gait without and with its own
+        window (the walk step audits the story walker without one): each walk recorded over the profile's
+        distance, its audit in energy/NAME/ (energy.json, energy.png; the initiation left out)."""
+        from drake_biped.common.walks import window_of
+        from drake_biped.episode import run_episode
+        from drake_biped.experiments.walk import write_energy
+
+        window, source, _ = self.learned_window()
+        other = "fast_servo" if self.story.gait == "paper" else "paper"
+        other_window = gait_compare_window(other)[0]
+        mine = self.level
+        theirs = self._walking_the_distance(load_gait(other))
+        walks = {"window": (mine.replace(window=window_of(window)),
+                            f"{self.story.gait}, {_window_label(window)} (the story's window)"),
+                 other: (theirs, f"{other}, no window"),
+                 f"{other}_window": (theirs.replace(window=window_of(other_window)),
+                                     f"{other}, {_window_label(other_window)} (its file's comparison window)")}
+
+        def run(folder: Path) -> dict:
+            rows = {}
+            for name, (config, label) in walks.items():
+                r = run_episode(config, record_trajectory=True)
+                (folder / name).mkdir(exist_ok=True)
+                rows[name] = {"label": label, "cost_of_transport": r.cost_of_transport, "fell": r.fell,
+                              "distance_m": r.distance_m,
+                              "energy": write_energy(r.trajectory, folder / name, label)}
+            return {"gait": self.story.gait, "distance_m": self.profile.distance_m, "window_source": source,
+                    "walks": rows}
+
+        return self.experiment("energy", {name: c.to_dict() for name, (c, _) in walks.items()}, run)
 
     def stability(self) -> dict:
         from drake_biped.experiments import stability

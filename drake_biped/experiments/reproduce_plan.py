@@ -110,7 +110,7 @@ class Profile:
 # What it is too small to judge, its report leaves to the full run (analysis.reproduce_report.quick_rows).
 QUICK = Profile("quick", 10.0, 2, 1, (2, 2), (2, 6), 0.2, 2, False, 25.0, (2, 25), False, (0.0005, 0.001), 10.0,
                 1.3, floquet_epsilons=(1e-7, 3e-7, 1e-6), floquet_newton_iterations=5, floquet_gaits=("none",),
-                steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "floquet"))
+                steps=("walk", "table_iii", "paper_gait", "full_run", "learn", "energy", "floquet"))
 # The full run: about 117 min on 2 workers from scratch on fast_servo (benchmarks/results/reproduce-full/,
 # each step's summary.json; the paper's walker takes Story.cost times as long), its largest parts the learners'
 # comparison (25 min), GARB's two learning runs (18 and 14 min), the push margins (21 min) and the Table IV grid
@@ -121,7 +121,7 @@ FULL = Profile("full", 10.0, 3, 3, (5, 500), (5, 300), 0.1, 8, True, 5.0, (2, 10
 
 # A reproduction's steps (`Reproduction`'s methods of these names): the paper's claims first; the learners side by
 # side, beyond the paper and the costliest step, last.
-STEPS = ("walk", "grid", "table_iii", "paper_gait", "full_run", "window_map", "learn", "learn_variant",
+STEPS = ("walk", "grid", "table_iii", "paper_gait", "full_run", "window_map", "learn", "learn_variant", "energy",
          "time_step", "stability", "push_margin", "floquet", "dynamics", "grid_slope2deg", "slope",
          "slope2deg", "compare_learners")
 
