@@ -12,9 +12,11 @@ from drake_biped.paper import TABLE_V
 from drake_biped.paper import TABLE_V_REDUCTION as PAPER_REDUCTION
 from drake_biped.paper import TABLE_VII as TABLE_VII_PAPER
 
-__all__ = ["climbs_2deg", "reduction_verdict", "slope_verdict", "stability_verdict", "table_v_claim",
+__all__ = ["climbs_2deg", "cost_without_verdict", "reduction_verdict", "slope_verdict", "stability_verdict", "table_v_claim",
            "table_vii_claim", "table_vii_rows"]
 
+# How near Table V's C_mt without the window ours must be to reproduce it (relative).
+COST_WITHOUT_TOLERANCE = 0.1
 # The symbols of Table VII's parameters as the report writes them.
 _SYMBOLS = {"u_a": "u_a", "u_r": "u_r", "kappa": "κ"}
 
@@ -34,6 +36,27 @@ def table_vii_claim() -> str:
     """Table VII's changes from Table III in the report's words: "u_a +37 %, u_r +25 %, κ +51 %"."""
     return ", ".join(f"{_SYMBOLS[name]} {_whole_percent(after / before - 1.0)}"
                      for name, (before, after) in TABLE_VII_PAPER.items())
+
+
+def cost_without_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
+    """Table V's first column, C_mt without the torque-free period: the learning run's walk without a window (its
+    long-run mean where the record has one), beside the paper's 0.58, read as the dimensionless C_mt and given in the
+    paper's printed unit (eq. 1 divides by kg, not by weight: C_mt x g, J/(kg*m)) too."""
+    from drake_biped.params import GRAVITY_MPS2
+
+    paper = TABLE_V["CPG without torque-free period"]
+    no_window = evaluation.get("no_window") or {}
+    cost = no_window.get("long_run_cost_of_transport")
+    measure = evaluation.get("measure", "") if cost is not None else "its walk"
+    if cost is None:
+        cost = no_window.get("cost_of_transport")
+    if cost is None:
+        return "—", NOT_REPRODUCED
+    ours = (f"{cost:.4f} ({measure}; {GRAVITY_MPS2 * cost:.2f} J/(kg·m) in eq. 1's printed unit), "
+            f"{cost / paper:.2f} × the paper's")
+    if abs(cost / paper - 1.0) <= COST_WITHOUT_TOLERANCE:
+        return ours, REPRODUCED
+    return ours, f"{DIFFERS}: {'below' if cost < paper else 'above'} the paper's by {abs(100 * (cost / paper - 1.0)):.0f} %"
 
 
 def _windows_kept(evaluation: dict[str, Any]) -> int:

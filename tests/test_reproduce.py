@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from drake_biped.analysis.dynamics_report import floquet_text
-from drake_biped.analysis.report_text import NOT_REPRODUCED, PARTLY, REPRODUCED, embed
+from drake_biped.analysis.report_text import DIFFERS, NOT_REPRODUCED, PARTLY, REPRODUCED, embed
 from drake_biped.analysis.verdicts import reduction_verdict, slope_verdict, stability_verdict, table_vii_rows
 from drake_biped.experiments.reproduce import QUICK, Profile, Reproduction, check_out, steps_of
 from drake_biped.params import ParameterError
@@ -27,6 +27,24 @@ def test_reduction_verdict_follows_the_papers_40_to_50_percent_claim():
     assert reduction_verdict(_evaluation(None))[1] == NOT_REPRODUCED
     ours, _ = reduction_verdict(_evaluation(0.35, ((0.1, 0.4, False), (0.5, 0.3, False), (0.1, 0.8, True))))
     assert "C_mt -35.0 %" in ours and "2 of 3 trials" in ours and "1 end with a window" in ours
+
+
+def test_table_v_without_the_window_is_judged_against_058_within_ten_percent():
+    """Table V's first column: the walk without a window's long-run C_mt (its whole walk's for a record without
+    one) against the paper's 0.58, within 10 % reproduced; also given in eq. 1's per-kg unit (x g)."""
+    from drake_biped.analysis.verdicts import cost_without_verdict
+
+    def evaluation(cost, long=True):
+        key = "long_run_cost_of_transport" if long else "cost_of_transport"
+        return {"measure": "110 m walks", "no_window": {key: cost}}
+
+    ours, verdict = cost_without_verdict(evaluation(0.2135))
+    assert verdict == f"{DIFFERS}: below the paper's by 63 %"
+    assert ours.startswith("0.2135 (110 m walks; 2.09 J/(kg·m)") and "0.37 × the paper's" in ours
+    assert cost_without_verdict(evaluation(0.62))[1] == REPRODUCED
+    assert cost_without_verdict(evaluation(0.64))[1] == f"{DIFFERS}: above the paper's by 10 %"
+    assert cost_without_verdict(evaluation(0.55, long=False))[0].startswith("0.5500 (its walk;")
+    assert cost_without_verdict({"no_window": None})[1] == NOT_REPRODUCED
 
 
 def test_a_floquet_row_gives_no_radius_where_no_perturbation_converged():
@@ -122,7 +140,7 @@ def test_a_whole_reproduction_writes_every_section_with_numbers_and_resumes(tmp_
     for heading in SECTIONS:
         assert heading in text, heading
     table = [line for line in text.splitlines() if line.startswith("| ") and "**" in line]
-    assert len(table) == 16
+    assert len(table) == 17
     for row in table:  # every verdict row holds a measured number and a verdict
         ours = row.split(" | ")[2]
         assert re.search(r"\d", ours), row
