@@ -642,6 +642,15 @@ def test_the_local_clusters_workers_log_only_critical_lines(client):
     assert client.submit(_worker_log_level, pure=False).result() == logging.CRITICAL
 
 
+def test_the_local_cluster_keeps_a_worker_whose_heartbeat_is_late(client):
+    """A run suspended for longer than Dask's worker-ttl (5 minutes: Ctrl-Z, a machine asleep) lost every task
+    running when it woke, the scheduler removing its workers before they could beat again: the embedded
+    cluster's scheduler checks no heartbeat's age (a local worker's death closes its connection)."""
+    scheduler = client.cluster.scheduler
+    assert scheduler.worker_ttl is None and "worker-ttl" not in scheduler.periodic_callbacks
+    assert len(scheduler.workers) == 2
+
+
 def test_a_walk_on_a_level_part_longer_than_60_m_runs(tmp_path, capsys):
     # The issue's command: exit 1 with Drake's "Box(): width = -40.008" (the drawn ground stopped at 60 m).
     out = tmp_path / "w"

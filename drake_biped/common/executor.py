@@ -236,8 +236,12 @@ def _local_cluster(n: int):
     # reads its logging levels on import): a task's failure reaches the driver, which says it in one line, and
     # what a worker logs at ERROR when the cluster closes under it (a heartbeat to a scheduler already gone,
     # after Ctrl-C) is not a failure of the run.
+    # The scheduler never drops a worker for a late heartbeat (Dask's worker-ttl, 5 minutes): its workers are this
+    # machine's processes, whose deaths it sees when their connections close, and a run suspended longer (Ctrl-Z,
+    # a laptop asleep) would otherwise lose every task running when it wakes, the workers removed before they
+    # could beat again.
     environ = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), "DASK_LOGGING__DISTRIBUTED": "critical"}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.scheduler.worker-ttl": None}):
         return LocalCluster(
             n_workers=n,
             threads_per_worker=1,
