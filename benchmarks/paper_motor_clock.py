@@ -9,6 +9,8 @@ or solved in the plant's step (motor_solve "plant", as shipped) at the given vel
 
     python benchmarks/paper_motor_clock.py --solve plant --out benchmarks/results/paper-walker/motor-plant --gain 1000 --h-ms 0.5 0.25 0.125
 
+Any other change, named in the files: `--override '{"contact.stiffness_npm": 5e5}' --tag k5e5`.
+
 One JSON file per walk, kept as it finishes: a rerun skips the walks already written."""
 
 from __future__ import annotations
@@ -47,7 +49,12 @@ def main() -> None:
                         help="the plant's motor's velocity gains (N*m*s/rad; --solve plant)")
     parser.add_argument("--h-ms", type=float, nargs="+", default=[0.5, 0.25, 0.125])
     parser.add_argument("--distance", type=float, default=110.0)
+    parser.add_argument("--override", type=json.loads, default={},
+                        help="more changes to every walk, as EpisodeConfig.override takes them (JSON)")
+    parser.add_argument("--tag", default="", help="added to the files' names (with --override)")
     args = parser.parse_args()
+    if bool(args.override) != bool(args.tag):
+        parser.error("--override and --tag go together")
     args.out.mkdir(parents=True, exist_ok=True)
     if args.solve == "controller":
         motors = [(f"tau{tau:g}ms", {"gait.motor_solve": "controller", "gait.motor_time_constant_s": tau * 1e-3})
@@ -56,17 +63,17 @@ def main() -> None:
         motors = [(f"gain{gain:g}", {"gait.motor_solve": "plant", "gait.motor_gain_nms": gain}) for gain in args.gain]
     for name, motor in motors:
         for h in args.h_ms:
-            path = args.out / f"{name}-h{h:g}ms.json"
+            path = args.out / f"{name}{'-' + args.tag if args.tag else ''}-h{h:g}ms.json"
             if path.exists():
                 continue
-            base = load_gait(args.gait).override({**motor, "sim.time_step_s": h * 1e-3})
+            base = load_gait(args.gait).override({**motor, **args.override, "sim.time_step_s": h * 1e-3})
             start = time.time()
             short = run_episode(base, record_trajectory=True)
             flips, saturated = swing_hip_torque_sign_changes(short.trajectory) if short.duration_s > 4.0 else (None, None)
             config = base.override({"sim.distance_m": args.distance, "sim.max_time_s": 6 * args.distance})
             result = run_episode(config)
             lr = None if result.fell else result.long_run()
-            record = {"gait": args.gait, "motor": motor, "time_step_ms": h,
+            record = {"gait": args.gait, "motor": motor, "override": args.override, "time_step_ms": h,
                       "distance_m": result.distance_m, "fell": result.fell, "cost_of_transport": result.cost_of_transport,
                       "long_run": lr, "sign_changes_per_s_10m": flips, "saturated_part_10m": saturated,
                       "walked_10m": {"fell": short.fell, "distance_m": short.distance_m,
