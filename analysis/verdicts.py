@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from drake_biped.analysis.cost_of_transport import GRAVITY_MPS2
 from drake_biped.analysis.report_text import DIFFERS, NOT_REPRODUCED, PARTLY, REPRODUCED, pct
 from drake_biped.analysis.rewalks import saving_spread, window_acted
 from drake_biped.analysis.series import cmt_change
@@ -42,8 +43,6 @@ def cost_without_verdict(evaluation: dict[str, Any]) -> tuple[str, str]:
     """Table V's first column, C_mt without the torque-free period: the learning run's walk without a window (its
     long-run mean where the record has one), beside the paper's 0.58, read as the dimensionless C_mt and given in the
     paper's printed unit (eq. 1 divides by kg, not by weight: C_mt x g, J/(kg*m)) too."""
-    from drake_biped.params import GRAVITY_MPS2
-
     paper = TABLE_V["CPG without torque-free period"]
     no_window = evaluation.get("no_window") or {}
     cost = no_window.get("long_run_cost_of_transport")
