@@ -205,8 +205,7 @@ def _halving_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, 
     windows = [(round(a * period, 4), round(b * period, 4)) for a, b in HALVING_WINDOWS]
     rows = _window_rows(config, windows, base)
     for row in rows:
-        cost = row.get("long_run_cost_of_transport")
-        row["saving"] = (1.0 - cost / base["long_run_cost_of_transport"]) if row["walked"] and cost else None
+        row["saving"] = _saving(row, base, "long_run_cost_of_transport") if row["walked"] else None
     savings = [r["saving"] for r in rows if r["saving"] is not None]
     best = max(savings) if savings else -0.5
     return max(-0.5, best) + 0.01 * len(savings), {**detail, "windows": rows, "best_saving": best}
@@ -238,11 +237,12 @@ def _story_score(config: EpisodeConfig, base: dict[str, Any], draws: int) -> tup
                    "distance_from_table_iii": d}
 
 
-def _saving(row: dict[str, Any], base: dict[str, Any]) -> float:
-    """C_mt saving of a walk with a window against `base` without one; -1 when either falls."""
-    if not (row["walked"] and base["walked"]):
+def _saving(row: dict[str, Any], base: dict[str, Any], key: str = "cost_of_transport") -> float:
+    """C_mt saving of a walk with a window against `base` without one, by the C_mt `key` names (the whole walk's,
+    or "long_run_cost_of_transport"); -1 when either falls or has none."""
+    if not (row["walked"] and base["walked"]) or not row.get(key) or not base.get(key):
         return -1.0
-    return 1.0 - row["cost_of_transport"] / base["cost_of_transport"]
+    return 1.0 - row[key] / base[key]
 
 
 def _hold_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:

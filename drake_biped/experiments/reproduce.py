@@ -85,10 +85,6 @@ SLOPE_2DEG_LEANS = (0.0, 0.04, 0.08, 0.12)
 SLOPE_2DEG_PLACEMENT = 0.1
 
 
-def _window_label(window: tuple[float, float]) -> str:
-    return f"window {window[0]:g}-{window[1]:g} s" if window[1] > window[0] else "no window"
-
-
 class Reproduction:
     """The output folder, the profile, the Dask client; runs each experiment once. `workers`/`scheduler`:
     what the run logs record of the cluster."""
@@ -366,6 +362,7 @@ class Reproduction:
         """Where the energy goes with the story's window, and on the other shipped gait without and with its own
         window (the walk step audits the story walker without one): each walk recorded over the profile's
         distance, its audit in energy/NAME/ (energy.json, energy.png; the initiation left out)."""
+        from drake_biped.analysis.series import window_text
         from drake_biped.common.walks import window_of
         from drake_biped.episode import run_episode
         from drake_biped.experiments.walk import write_energy
@@ -376,10 +373,10 @@ class Reproduction:
         mine = self.level
         theirs = self._walking_the_distance(load_gait(other))
         walks = {"window": (mine.replace(window=window_of(window)),
-                            f"{self.story.gait}, {_window_label(window)} (the story's window)"),
+                            f"{self.story.gait}, window {window_text(*window, 4)} (the story's window)"),
                  other: (theirs, f"{other}, no window"),
                  f"{other}_window": (theirs.replace(window=window_of(other_window)),
-                                     f"{other}, {_window_label(other_window)} (its file's comparison window)")}
+                                     f"{other}, window {window_text(*other_window, 4)} (its file's comparison window)")}
 
         def run(folder: Path) -> dict:
             rows = {}
