@@ -57,17 +57,26 @@ def grid_phase_rows(config, distance_m: float) -> dict:
     out = {"walked": not r.fell, "distance_m": r.distance_m, "steps": int(periods.size)}
     if periods.size < 2 * BINS:
         return out
-    bins = np.minimum((phases * BINS).astype(int), BINS - 1)
-    means = [float(periods[bins == b].mean()) if np.any(bins == b) else None for b in range(BINS)]
-    within = sum(float(((periods[bins == b] - periods[bins == b].mean()) ** 2).sum()) for b in range(BINS)
-                 if np.any(bins == b))
-    total = float(((periods - periods.mean()) ** 2).sum())
+    explained, chance, means = variance_explained_by_phase(periods, phases, BINS)
     out.update({"step_period_mean_s": float(periods.mean()), "step_period_std_s": float(periods.std(ddof=1)),
                 "lag1_autocorrelation": float(np.corrcoef(periods[:-1], periods[1:])[0, 1]),
-                "variance_explained_by_grid_phase": 1.0 - within / total if total > 0 else None,
-                "variance_explained_by_chance": (BINS - 1) / (periods.size - 1),
+                "variance_explained_by_grid_phase": explained, "variance_explained_by_chance": chance,
                 "period_by_grid_phase_s": means, "periods_s": periods.tolist(), "grid_phases": phases.tolist()})
     return out
+
+
+def variance_explained_by_phase(values, phases, bins: int = BINS) -> tuple[float | None, float, list]:
+    """The share of `values`' variance that their phases in [0, 1) explain, binned into `bins` equal bins
+    (1 - within-bin sum of squares / total); the share bins explain by chance, (bins - 1) / (n - 1); and each
+    bin's mean (None for an empty bin)."""
+    values, phases = np.asarray(values, float), np.asarray(phases, float)
+    which = np.minimum((phases * bins).astype(int), bins - 1)
+    means = [float(values[which == b].mean()) if np.any(which == b) else None for b in range(bins)]
+    within = sum(float(((values[which == b] - values[which == b].mean()) ** 2).sum())
+                 for b in range(bins) if np.any(which == b))
+    total = float(((values - values.mean()) ** 2).sum())
+    explained = 1.0 - within / total if np.ptp(values) > 0 else None
+    return explained, (bins - 1) / (values.size - 1), means
 
 
 def contact_rows(config, distance_m: float = 30.0) -> dict:
