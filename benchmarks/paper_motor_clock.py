@@ -38,6 +38,19 @@ def swing_hip_torque_sign_changes(trajectory: dict, after_s: float = 3.0) -> tup
     return swing_hip_sign_changes_per_s(trajectory, after_s), float(np.mean(np.abs(tau) >= 0.99 * np.abs(tau).max()))
 
 
+def parse_with_change(parser: argparse.ArgumentParser) -> argparse.Namespace:
+    """`parser`'s arguments with --override (more changes to every walk) and --tag (naming them in the files'
+    names), which go together; --out made."""
+    parser.add_argument("--override", type=json.loads, default={},
+                        help="more changes to every walk, as EpisodeConfig.override takes them (JSON)")
+    parser.add_argument("--tag", default="", help="added to the files' names (with --override)")
+    args = parser.parse_args()
+    if bool(args.override) != bool(args.tag):
+        parser.error("--override and --tag go together")
+    args.out.mkdir(parents=True, exist_ok=True)
+    return args
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, required=True)
@@ -49,13 +62,7 @@ def main() -> None:
                         help="the plant's motor's velocity gains (N*m*s/rad; --solve plant)")
     parser.add_argument("--h-ms", type=float, nargs="+", default=[0.5, 0.25, 0.125])
     parser.add_argument("--distance", type=float, default=110.0)
-    parser.add_argument("--override", type=json.loads, default={},
-                        help="more changes to every walk, as EpisodeConfig.override takes them (JSON)")
-    parser.add_argument("--tag", default="", help="added to the files' names (with --override)")
-    args = parser.parse_args()
-    if bool(args.override) != bool(args.tag):
-        parser.error("--override and --tag go together")
-    args.out.mkdir(parents=True, exist_ok=True)
+    args = parse_with_change(parser)
     if args.solve == "controller":
         motors = [(f"tau{tau:g}ms", {"gait.motor_solve": "controller", "gait.motor_time_constant_s": tau * 1e-3})
                   for tau in args.tau_ms]

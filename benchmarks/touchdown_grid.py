@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from paper_motor_clock import parse_with_change
 
 from drake_biped.episode import run_episode
 from drake_biped.kinematics import leg_points
@@ -131,13 +132,7 @@ def main() -> None:
     parser.add_argument("--gait", default="paper", help="a shipped gait's name or a parameter file")
     parser.add_argument("--h-ms", type=float, nargs="+", default=[0.5, 0.25])
     parser.add_argument("--distance", type=float, default=110.0)
-    parser.add_argument("--override", type=json.loads, default={},
-                        help="more changes to every walk, as EpisodeConfig.override takes them (JSON)")
-    parser.add_argument("--tag", default="", help="added to the files' names (with --override)")
-    args = parser.parse_args()
-    if bool(args.override) != bool(args.tag):
-        parser.error("--override and --tag go together")
-    args.out.mkdir(parents=True, exist_ok=True)
+    args = parse_with_change(parser)
     base = load_gait(args.gait).override(args.override) if args.override else load_gait(args.gait)
     stem = Path(args.gait).stem + (f"-{args.tag}" if args.tag else "")
     for h_ms in args.h_ms:

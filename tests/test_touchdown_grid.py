@@ -4,13 +4,17 @@ plant's grid explain, checked on series whose dependence on the phase is chosen.
 from __future__ import annotations
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
 
 
 def _module():
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "touchdown_grid.py"
+    folder = Path(__file__).resolve().parents[1] / "benchmarks"
+    if str(folder) not in sys.path:  # the script imports its neighbour, as when run from there
+        sys.path.insert(0, str(folder))
+    path = folder / "touchdown_grid.py"
     spec = importlib.util.spec_from_file_location("touchdown_grid_under_test", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
