@@ -126,6 +126,37 @@ def _row_text(name: str, d: dict) -> str:
             f"{1e3 * c['mid_swing_clearance_m']['median']:+.2f} mm, {c['mid_swing_scuffs']} of {c['steps']} |")
 
 
+def _figure(records: dict, path: Path) -> None:
+    """Each walk's step periods against their touchdowns' grid phases, less the walk's mean, one panel a walk."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    walks = {k: r["grid"] for k, r in records.items() if "periods_s" in r["grid"]}
+    if not walks:
+        return
+    columns = min(4, len(walks))
+    rows = -(-len(walks) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(3.2 * columns, 2.6 * rows), sharey=True, squeeze=False)
+    for ax, (name, g) in zip(axes.flat, walks.items()):
+        periods = 1e3 * (np.array(g["periods_s"]) - g["step_period_mean_s"])
+        ax.plot(g["grid_phases"], periods, ".", ms=4)
+        ax.set_title(f"{name}\nsd {1e3 * g['step_period_std_s']:.2f} ms, grid phase "
+                     f"{g['variance_explained_by_grid_phase']:.2f}", fontsize=8)
+        ax.set_xlim(0, 1)
+        ax.grid(alpha=0.3)
+    for ax in axes.flat[len(walks):]:
+        ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("touchdown's phase on the plant's grid")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("step period − mean (ms)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, required=True)
@@ -150,7 +181,9 @@ def main() -> None:
         record["wall_time_s"] = time.perf_counter() - start
         path.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n")
         print(_row_text(path.stem, record), flush=True)
-    rows = [_row_text(p.stem, json.loads(p.read_text())) for p in sorted(args.out.glob("*.json"))]
+    records = {p.stem: json.loads(p.read_text()) for p in sorted(args.out.glob("*.json"))}
+    rows = [_row_text(name, record) for name, record in records.items()]
+    _figure(records, args.out / "touchdown_grid.png")
     (args.out / "touchdown_grid.md").write_text(
         "| walk | step period sd | variance the grid phase explains | range of the phase-binned means | "
         "first overlap, its correlation with the period | mid-swing clearance (median), steps scuffing |\n"
