@@ -81,7 +81,8 @@ def main() -> None:
             result = run_episode(config)
             lr = None if result.fell else result.long_run()
             record = {"gait": args.gait, "motor": motor, "override": args.override, "time_step_ms": h,
-                      "distance_m": result.distance_m, "fell": result.fell, "cost_of_transport": result.cost_of_transport,
+                      "distance_m": result.distance_m, "fell": result.fell, "fall_reason": result.fall_reason,
+                      "cost_of_transport": result.cost_of_transport,
                       "long_run": lr, "sign_changes_per_s_10m": flips, "saturated_part_10m": saturated,
                       "walked_10m": {"fell": short.fell, "distance_m": short.distance_m,
                                      "cost_of_transport": short.cost_of_transport, "wall_s": short.wall_time_s},
