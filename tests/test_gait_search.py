@@ -424,3 +424,16 @@ def test_halving_objective_walks_windows_placed_by_the_step_only_where_the_swing
     assert value == pytest.approx(0.5 + 0.01 * (len(expected) - 1))  # the window to 1.2 x the step falls
     monkeypatch.setattr(objectives, "_robust_score", lambda c, b: (-0.4, {"checks": {}}))
     assert objectives.score(config, objective="halving")[0] == pytest.approx(-2.4)
+
+
+def test_an_objectives_walk_row_says_how_the_walk_ended():
+    """A search's record tells a walk that ended on its distance from one stopped by the time limit (or a fall, or
+    a failed contact solve: EpisodeResult.termination), each as the episode itself said."""
+    from drake_biped.experiments import objectives
+    from drake_biped.resources import load_gait
+
+    short = load_gait("paper").override({"sim.distance_m": 0.3, "sim.max_time_s": 4.0})
+    walked = objectives._walk(short)
+    assert walked["walked"] and walked["termination"] == "distance"
+    stopped = objectives._walk(short.override({"sim.max_time_s": 0.2}))
+    assert not stopped["walked"] and stopped["termination"] == "time limit"

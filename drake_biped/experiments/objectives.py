@@ -86,6 +86,8 @@ def _walk(config: EpisodeConfig) -> dict[str, Any]:
     total = sum(positive.values())
     return {
         "walked": walked,
+        # how it ended: "distance", or a fall's reason ("simulation failed: ..." where the contact solve failed)
+        "termination": r.termination,
         "cost_of_transport": r.cost_of_transport,
         "distance_m": r.distance_m,
         "reward": reward(r.cost_of_transport, r.distance_m, config.sim.distance_m),
