@@ -31,6 +31,7 @@ from paper_motor_clock import parse_with_change
 from drake_biped.episode import run_episode
 from drake_biped.kinematics import leg_points
 from drake_biped.model import joint_index
+from drake_biped.params import walked_the_distance
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
@@ -49,13 +50,14 @@ def _sole(q: np.ndarray, leg: str) -> tuple[float, float]:
 def grid_phase_rows(config, distance_m: float) -> dict:
     """A walk's step periods after the transient, their touchdowns' grid phases, and the binned means."""
     h = config.sim.time_step_s
-    r = run_episode(config.override({"sim.distance_m": distance_m}))
+    r = run_episode(config.override({"sim.distance_m": distance_m, "sim.max_time_s": 6.0 * distance_m}))
     td = r.touchdowns
     t, x = td["touchdown_time_s"], td["com_x_m"]
     k = int(np.searchsorted(x - x[0], TRANSIENT_M))
     periods = np.diff(t[k:])
     phases = (t[k:-1] / h) % 1.0
-    out = {"walked": not r.fell, "distance_m": r.distance_m, "steps": int(periods.size)}
+    out = {"walked": walked_the_distance(r.fell, r.distance_m, distance_m), "termination": r.termination,
+           "distance_m": r.distance_m, "steps": int(periods.size)}
     if periods.size < 2 * BINS:
         return out
     explained, chance, means = variance_explained_by_phase(periods, phases, BINS)
@@ -83,7 +85,8 @@ def variance_explained_by_phase(values, phases, bins: int = BINS) -> tuple[float
 def contact_rows(config, distance_m: float = 30.0) -> dict:
     """Per step after AFTER_S: the new stance foot's first overlap (m, positive into the ground), the swing
     foot's least clearance in mid-swing (m), and the step's period."""
-    r = run_episode(config.override({"sim.distance_m": distance_m}), record_trajectory=True)
+    r = run_episode(config.override({"sim.distance_m": distance_m, "sim.max_time_s": 6.0 * distance_m}),
+                    record_trajectory=True)
     tr = r.trajectory
     t, q, right, start = tr["time"], tr["positions"], tr["stance_right"] > 0.5, tr["step_start"]
     starts = np.unique(start)
@@ -116,8 +119,8 @@ def contact_rows(config, distance_m: float = 30.0) -> dict:
 
 def _row_text(name: str, d: dict) -> str:
     g, c = d["grid"], d["contact"]
-    if "step_period_std_s" not in g:
-        return f"| {name} | falls or too few steps ({g['steps']}) | | | | | |"
+    if not g["walked"] or "step_period_std_s" not in g:
+        return f"| {name} | {g.get('termination', 'fell')} at {g['distance_m']:.1f} m ({g['steps']} steps) | | | | |"
     return (f"| {name} | {1e3 * g['step_period_std_s']:.2f} ms | {g['variance_explained_by_grid_phase']:.2f} "
             f"(chance {g['variance_explained_by_chance']:.2f}) | "
             f"{1e3 * (max(v for v in g['period_by_grid_phase_s'] if v) - min(v for v in g['period_by_grid_phase_s'] if v)):.1f} ms | "
@@ -133,7 +136,7 @@ def _figure(records: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    walks = {k: r["grid"] for k, r in records.items() if "periods_s" in r["grid"]}
+    walks = {k: r["grid"] for k, r in records.items() if r["grid"]["walked"] and "periods_s" in r["grid"]}
     if not walks:
         return
     columns = min(4, len(walks))
