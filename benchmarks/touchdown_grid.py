@@ -15,13 +15,15 @@ at each plant step:
     python benchmarks/touchdown_grid.py --gait paper --out benchmarks/results/paper-walker/touchdown-grid --h-ms 0.5 0.25
 
 Any other change, named in the files: `--override '{"gait.motor_solve": "plant"}' --tag plant`. One JSON file per
-walker and step, kept as it finishes (a rerun skips those written), and a table of all of them in `touchdown_grid.md`.
+walker and step, kept as it finishes (a rerun skips those written), and a table of all of them in `touchdown_grid.md`. A folder
+holding a `touchdown_grid.md` or `.png` the script did not write is refused (exit 2); other files are left alone.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -160,6 +162,33 @@ def _figure(records: dict, path: Path) -> None:
     plt.close(fig)
 
 
+TABLE_HEADER = ("| walk | step period sd | variance the grid phase explains | range of the phase-binned means | "
+                "first overlap, its correlation with the period | mid-swing clearance (median), steps scuffing |\n"
+                "|---|---|---|---|---|---|\n")
+COMMAND = "python benchmarks/touchdown_grid.py"
+
+
+def own_records(out: Path) -> dict:
+    """The records this script wrote in `out` (by their command), by name; any other JSON file is left alone."""
+    records = {}
+    for path in sorted(out.glob("*.json")):
+        try:
+            record = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        if isinstance(record, dict) and str(record.get("command", "")).startswith(COMMAND):
+            records[path.stem] = record
+    return records
+
+
+def foreign_summary(out: Path) -> Path | None:
+    """A touchdown_grid.md in `out` this script did not write, or a touchdown_grid.png without its table: the
+    summary would replace a file of the user's. None when there is none."""
+    table, figure = out / "touchdown_grid.md", out / "touchdown_grid.png"
+    ours = table.is_file() and table.read_text(errors="replace").startswith(TABLE_HEADER)
+    return next((path for path in (table, figure) if path.exists() and not ours), None)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, required=True)
@@ -167,6 +196,11 @@ def main() -> None:
     parser.add_argument("--h-ms", type=float, nargs="+", default=[0.5, 0.25])
     parser.add_argument("--distance", type=float, default=110.0)
     args = parse_with_change(parser)
+    foreign = foreign_summary(args.out)
+    if foreign is not None:
+        print(f"touchdown_grid.py: --out {args.out} holds {foreign.name}, which this script did not write; choose "
+              "another folder", file=sys.stderr)
+        raise SystemExit(2)
     base = load_gait(args.gait).override(args.override) if args.override else load_gait(args.gait)
     stem = Path(args.gait).stem + (f"-{args.tag}" if args.tag else "")
     for h_ms in args.h_ms:
@@ -178,19 +212,16 @@ def main() -> None:
         record = {"gait": args.gait, "override": args.override, "time_step_s": h_ms * 1e-3,
                   "grid": grid_phase_rows(config, args.distance), "contact": contact_rows(config),
                   "wall_time_s": None, "config": config.to_dict(), "versions": versions(),
-                  "command": "python benchmarks/touchdown_grid.py " + " ".join(
+                  "command": f"{COMMAND} " + " ".join(
                       [f"--gait {args.gait}", f"--out {args.out}", f"--h-ms {h_ms:g}", f"--distance {args.distance:g}"]
                       + ([f"--override '{json.dumps(args.override)}' --tag {args.tag}"] if args.tag else []))}
         record["wall_time_s"] = time.perf_counter() - start
         path.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n")
         print(_row_text(path.stem, record), flush=True)
-    records = {p.stem: json.loads(p.read_text()) for p in sorted(args.out.glob("*.json"))}
+    records = own_records(args.out)
     rows = [_row_text(name, record) for name, record in records.items()]
     _figure(records, args.out / "touchdown_grid.png")
-    (args.out / "touchdown_grid.md").write_text(
-        "| walk | step period sd | variance the grid phase explains | range of the phase-binned means | "
-        "first overlap, its correlation with the period | mid-swing clearance (median), steps scuffing |\n"
-        "|---|---|---|---|---|---|\n" + "\n".join(rows) + "\n")
+    (args.out / "touchdown_grid.md").write_text(TABLE_HEADER + "\n".join(rows) + "\n")
 
 
 if __name__ == "__main__":

@@ -22,7 +22,9 @@ from urllib.parse import unquote, urlparse
 
 import numpy as np
 from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
     AddContactMaterial,
+    AddRigidHydroelasticProperties,
     Box,
     HalfSpace,
     ProximityProperties,
@@ -106,16 +108,17 @@ def add_biped(
     """Add the biped (`model`, or the shipped one) and the ground to `builder`, finalize the plant and read
     the controller's body from it.
 
-    Contact: point contact (the heel/toe spheres against the ground half-space(s)), solved by the discrete
-    contact approximation given (SAP by default), with the material of `contact` (params.ContactParams; its
-    defaults when None) on the foot spheres and the ground. Output ports are sampled (see controller "Timing").
+    Contact: the heel/toe spheres against the ground half-space(s), as point contacts or, under `contact.model`
+    "hydroelastic", as compliant hydroelastic spheres against the rigid ground; solved by the discrete contact
+    approximation given (SAP by default), with the material of `contact` (params.ContactParams; its defaults
+    when None) on the foot spheres and the ground. Output ports are sampled (see controller "Timing").
     """
     contact = contact or ContactParams()
     config = MultibodyPlantConfig(
         time_step=time_step_s,
         use_sampled_output_ports=True,
         discrete_contact_approximation=contact_approximation,
-        contact_model="point",
+        contact_model="point" if contact.model == "point" else "hydroelastic_with_fallback",
         penetration_allowance=1e-3,
         sap_near_rigid_threshold=contact.sap_near_rigid_threshold,
     )
@@ -141,6 +144,29 @@ def _with_material(props: ProximityProperties, contact: ContactParams) -> Proxim
     return props
 
 
+def _foot_properties(props: ProximityProperties, contact: ContactParams) -> ProximityProperties:
+    """A foot sphere's properties: the material, and under the hydroelastic model a compliant hydroelastic
+    sphere with the contact's modulus, mesh and margin."""
+    props = _with_material(props, contact)
+    if contact.model == "hydroelastic":
+        AddCompliantHydroelasticProperties(contact.resolution_hint_m, contact.hydroelastic_modulus_pa, props)
+        if contact.margin_m > 0.0:
+            props.AddProperty("hydroelastic", "margin", float(contact.margin_m))
+    return props
+
+
+def _ground_properties(props: ProximityProperties, contact: ContactParams, boxed: bool) -> ProximityProperties:
+    """The ground's properties: the material, and under the hydroelastic model rigid hydroelastic (a box's
+    surface meshed at a tenth of its depth: its top face is flat, any mesh represents it exactly)."""
+    props = _with_material(props, contact)
+    if contact.model == "hydroelastic":
+        if boxed:
+            AddRigidHydroelasticProperties(0.1 * GROUND_DEPTH_M, props)
+        else:
+            AddRigidHydroelasticProperties(props)
+    return props
+
+
 def _set_feet_material(plant: MultibodyPlant, scene_graph: SceneGraph, contact: ContactParams) -> None:
     """Give every collision geometry of the feet the contact's material, keeping the model's friction."""
     inspector = scene_graph.model_inspector()
@@ -149,7 +175,7 @@ def _set_feet_material(plant: MultibodyPlant, scene_graph: SceneGraph, contact: 
             continue  # check_layout and body_of name what is missing
         for geometry in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(name)):
             props = ProximityProperties(inspector.GetProximityProperties(geometry))
-            scene_graph.AssignRole(plant.get_source_id(), geometry, _with_material(props, contact),
+            scene_graph.AssignRole(plant.get_source_id(), geometry, _foot_properties(props, contact),
                                    RoleAssign.kReplace)
 
 
@@ -255,12 +281,12 @@ def _add_ground(plant: MultibodyPlant, ground: Ground, contact: ContactParams) -
         X = RigidTransform(rotation, [through_x, 0.0, 0.0])
         props = ProximityProperties()
         AddContactMaterial(friction=friction, properties=props)
-        plant.RegisterCollisionGeometry(world, X, HalfSpace(), name, _with_material(props, contact))
+        plant.RegisterCollisionGeometry(world, X, HalfSpace(), name, _ground_properties(props, contact, False))
 
     def add_ground_box(name: str, angle: float, x0: float, x1: float) -> None:
         # A box whose top face is the ground from x0 to x1 (measured along the ground), rising at `angle` from
         # (x0, 0, 0), GROUND_DEPTH_M deep.
-        props = _with_material(ProximityProperties(), contact)
+        props = _ground_properties(ProximityProperties(), contact, True)
         AddContactMaterial(friction=friction, properties=props)
         rotation = RotationMatrix.MakeYRotation(-angle)
         centre = rotation.multiply(np.array([0.5 * (x1 - x0), 0.0, -0.5 * GROUND_DEPTH_M])) + np.array([x0, 0.0, 0.0])

@@ -396,7 +396,8 @@ class SimulationParams(Validated):
 
 @dataclass(frozen=True)
 class ContactParams(Validated):
-    """The contact between the feet and the ground: compliant point contact, its physical parameters explicit.
+    """The contact between the feet and the ground: compliant point contact (or, `model` "hydroelastic", the
+    foot spheres as compliant hydroelastic spheres), its physical parameters explicit.
 
     Each of the four foot spheres and the ground carries the same material (the model file's own values for
     these three are replaced; its friction is kept). Drake combines a pair's stiffnesses in series (k/2 for two
@@ -409,7 +410,13 @@ class ContactParams(Validated):
     `sap_near_rigid_threshold` 0 turns off SAP's near-rigid regime. At Drake's default (1.0) SAP regularises
     a contact it judges too stiff for the step by an amount that depends on the step: the contact changes when
     the step is halved and long walks do not converge (docs/RESULTS.md, "Physics with a continuous limit"). A field left None takes
-    Drake's default."""
+    Drake's default.
+
+    Under `model` "hydroelastic" a sphere's force grows with the square of its depth (pi E x^2) instead of
+    linearly, so a touchdown that falls inside a plant step starts with almost no force wherever in the step it
+    falls; its tetrahedral mesh must be fine against the spheres' 1 cm radius (at 2 mm a 0.2 mm sink carries 44 %
+    of pi E x^2, at 0.5 mm 95 %), and a fine mesh costs wall time (docs/RESULTS.md). `stiffness_npm` is then
+    unread."""
 
     stiffness_npm: float | None = param(1e6, "N/m", "point-contact stiffness of each foot sphere and the ground "
                                         "(None: Drake's default)", 1e2, 1e9)
@@ -420,6 +427,27 @@ class ContactParams(Validated):
         "(None: Drake's default)", 0.0, 1e3)
     sap_near_rigid_threshold: float = param(0.0, "1", "SAP's near-rigid threshold (0: the regime off; Drake's "
                                             "default 1)", 0.0, 10.0)
+    model: str = param("point", "", 'the contact model: "point", each foot sphere a point contact of stiffness_npm; '
+                       '"hydroelastic", each foot sphere a compliant hydroelastic sphere (hydroelastic_modulus_pa, '
+                       'resolution_hint_m, margin_m) pressed into the rigid ground')
+    hydroelastic_modulus_pa: float = param(
+        3e8, "Pa", "the foot spheres' hydroelastic modulus (model \"hydroelastic\"): a sphere of radius R pressed x "
+        "into the ground carries pi E x^2 (0.23 mm for half the shipped robot's weight at the default)", 1e5, 1e12)
+    resolution_hint_m: float = param(
+        2e-3, "m", "the foot spheres' tetrahedral mesh, its typical edge (model \"hydroelastic\"): the force "
+        "follows the mesh's facets, coarser meshes walk less regularly (5 mm on the 1 cm spheres: measured)",
+        1e-4, 0.05)
+    margin_m: float = param(
+        0.0, "m", "the foot spheres' hydroelastic margin (model \"hydroelastic\"): within it the discrete solver "
+        "adds a speculative contact constraint, so a touchdown inside a plant step is met in that step (Drake "
+        "recommends 0.1-1 mm; it costs wall time)", 0.0, 0.01)
+
+    MODELS = ("point", "hydroelastic")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.model not in self.MODELS:
+            raise ParameterError(f"ContactParams.model = {self.model!r} is not one of {list(self.MODELS)}")
 
 
 # What a record written before the contact was made explicit ran on: Drake's defaults for every material

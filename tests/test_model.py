@@ -1,5 +1,6 @@
 """The plant read back from models/biped.urdf against Table I and the documented limits."""
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -465,6 +466,52 @@ def test_the_contact_material_is_the_configurations_on_every_foot_sphere_and_the
         assert props.GetProperty("material", "hunt_crossley_dissipation") == 7.0
         assert props.GetProperty("material", "coulomb_friction").dynamic_friction() == 1.0
     assert plant.get_sap_near_rigid_threshold() == 0.5
+
+
+@pytest.mark.parametrize("sink_m", [2e-4, 4e-4])
+def test_hydroelastic_feet_carry_the_pressure_fields_force(sink_m):
+    """Under the hydroelastic model each foot sphere is a compliant hydroelastic sphere with the contact's
+    modulus, mesh and margin, and the ground rigid: with the feet flat and sunk x into the ground (no margin),
+    the four contact surfaces' pressures integrate to the hydroelastic sphere's 4 pi E x^2 (a fine mesh: within
+    6 %), and no pair falls back to point contact."""
+    from pydrake.geometry import HydroelasticContactRepresentation
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_biped.kinematics import leg_points
+    from drake_biped.params import ContactParams
+
+    contact = ContactParams(model="hydroelastic", hydroelastic_modulus_pa=2e8, resolution_hint_m=5e-4)
+    for margin in (0.0, 1e-4):
+        handles = add_biped(DiagramBuilder(), Ground(), 1e-3, contact=dataclasses.replace(contact, margin_m=margin))
+        plant, inspector = handles.plant, handles.scene_graph.model_inspector()
+        for name in ("left_foot", "right_foot"):
+            for g in plant.GetCollisionGeometriesForBody(plant.GetBodyByName(name)):
+                props = inspector.GetProximityProperties(g)
+                assert props.GetProperty("hydroelastic", "hydroelastic_modulus") == 2e8
+                assert props.GetProperty("hydroelastic", "resolution_hint") == 5e-4
+                assert props.GetPropertyOrDefault("hydroelastic", "margin", 0.0) == margin
+    builder = DiagramBuilder()
+    handles = add_biped(builder, Ground(), 1e-3, contact=contact)
+    plant = handles.plant
+    diagram = builder.Build()
+    plant_context = plant.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
+    flat = leg_points(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, handles.body)
+    q = np.zeros(9)
+    q[1] = -min(flat.heel_z, flat.toe_z) - sink_m
+    plant.SetPositions(plant_context, q)
+    query = plant.get_geometry_query_input_port().Eval(plant_context)
+    surfaces, point_pairs = query.ComputeContactSurfacesWithFallback(HydroelasticContactRepresentation.kPolygon)
+    assert len(surfaces) == 4 and not point_pairs  # every foot pair is hydroelastic, none fell back
+    force = sum(s.poly_mesh_W().area(f) * s.poly_e_MN().EvaluateCartesian(f, s.poly_mesh_W().element_centroid(f))
+                for s in surfaces for f in range(s.poly_mesh_W().num_faces()))
+    assert force == pytest.approx(4 * math.pi * 2e8 * sink_m ** 2, rel=0.06)
+
+
+def test_an_unknown_contact_model_is_refused_by_name():
+    from drake_biped.params import ContactParams, ParameterError
+
+    with pytest.raises(ParameterError, match="ContactParams.model = 'soft'"):
+        ContactParams(model="soft")
 
 
 def test_the_default_contact_is_drakes_default_material_without_the_near_rigid_regime():

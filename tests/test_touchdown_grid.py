@@ -40,3 +40,20 @@ def test_the_grid_phase_share_is_near_one_for_a_sawtooth_and_near_chance_for_per
     # a constant has no variance to explain; an empty bin has no mean
     assert explained_by(np.full(20, 0.9), np.linspace(0, 0.49, 20), 8)[0] is None
     assert explained_by(saw[:20], np.linspace(0, 0.49, 20), 8)[2][-1] is None
+
+
+def test_the_summary_never_replaces_a_users_file_and_only_the_scripts_records_are_read(tmp_path):
+    """A folder with a touchdown_grid.md or .png the script did not write is refused (its summary would replace
+    them); the script's own summary is rewritten; only records its command wrote enter the table."""
+    module = _module()
+    assert module.foreign_summary(tmp_path) is None
+    (tmp_path / "touchdown_grid.png").write_bytes(b"a user's figure")
+    assert module.foreign_summary(tmp_path) == tmp_path / "touchdown_grid.png"
+    (tmp_path / "touchdown_grid.md").write_text("# my notes\n")
+    assert module.foreign_summary(tmp_path) == tmp_path / "touchdown_grid.md"
+    (tmp_path / "touchdown_grid.md").write_text(module.TABLE_HEADER + "| a row |\n")
+    assert module.foreign_summary(tmp_path) is None
+    (tmp_path / "mine.json").write_text('{"command": "python my_script.py"}')
+    (tmp_path / "broken.json").write_text("{")
+    (tmp_path / "walk-h0.5ms.json").write_text('{"command": "python benchmarks/touchdown_grid.py --gait paper"}')
+    assert list(module.own_records(tmp_path)) == ["walk-h0.5ms"]
