@@ -72,12 +72,15 @@ def section_value(q: np.ndarray, stance_right: bool, body=TABLE_I_BODY) -> float
 
 @dataclass
 class Snapshot:
-    """The diagram's discrete state at an update time: plant state (18), held torques (6), controller."""
+    """The diagram's discrete state at an update time: plant state (18), held torques (6), controller, and
+    the plant's hip motors' held command (the "motor_command" group; None in a record written before it was
+    kept, restored as the group's default)."""
 
     time_s: float
     plant: np.ndarray
     torques: np.ndarray
     controller: np.ndarray
+    command: np.ndarray | None = None
 
     @property
     def stance_right(self) -> bool:
@@ -85,13 +88,18 @@ class Snapshot:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON: a non-finite controller slot (the distance target, a lagged value not yet read) as None."""
-        return {"time_s": self.time_s, "plant": self.plant.tolist(), "torques": self.torques.tolist(),
-                "controller": [float(v) if math.isfinite(v) else None for v in self.controller]}
+        out = {"time_s": self.time_s, "plant": self.plant.tolist(), "torques": self.torques.tolist(),
+               "controller": [float(v) if math.isfinite(v) else None for v in self.controller]}
+        if self.command is not None:
+            out["command"] = self.command.tolist()
+        return out
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Snapshot:
+        command = d.get("command")
         return cls(float(d["time_s"]), np.array(d["plant"], float), np.array(d["torques"], float),
-                   np.array([math.nan if v is None else v for v in d["controller"]], float))
+                   np.array([math.nan if v is None else v for v in d["controller"]], float),
+                   None if command is None else np.array(command, float))
 
 
 class SectionMap:
@@ -168,7 +176,8 @@ class SectionMap:
         c[ctl.STATE_TIME] -= template.time_s
         c[ctl.TARGET_X] = math.inf
         c[ctl.DONE] = c[ctl.FALL] = 0.0
-        return Snapshot(0.0, plant, template.torques.copy(), c)
+        return Snapshot(0.0, plant, template.torques.copy(), c,
+                        None if template.command is None else template.command.copy())
 
     def section_normal(self) -> np.ndarray:
         """∇g in section coordinates at the template: with the stance knee held at the template's angle,
@@ -191,7 +200,8 @@ class SectionMap:
         return Snapshot(root.get_time(),
                         self._parts.plant.GetPositionsAndVelocities(self._parts.plant.GetMyContextFromRoot(root)),
                         ctrl_ctx.get_discrete_state(ctrl.torque_group).value().copy(),
-                        ctrl_ctx.get_discrete_state(ctrl.state_group).value().copy())
+                        ctrl_ctx.get_discrete_state(ctrl.state_group).value().copy(),
+                        ctrl_ctx.get_discrete_state(ctrl.command_group).value().copy())
 
     def _restore(self, snap: Snapshot) -> None:
         root = self._simulator.get_mutable_context()
@@ -204,6 +214,11 @@ class SectionMap:
         ctrl.set_episode(ctrl_ctx, self.config)
         ctrl_ctx.get_mutable_discrete_state(ctrl.torque_group).SetFromVector(snap.torques)
         ctrl_ctx.get_mutable_discrete_state(ctrl.state_group).SetFromVector(snap.controller)
+        if snap.command is not None:
+            ctrl_ctx.get_mutable_discrete_state(ctrl.command_group).SetFromVector(snap.command)
+        # The plant's hip motors take their gains and bounds from the plant's model, not from a Context: give
+        # them the restored state's, as an episode's start does (else they keep the last walk's roles).
+        ctrl.apply_motors(ctrl.law(ctrl_ctx), snap.controller)
 
     def _advance(self, k: int) -> Snapshot | None:
         """Advance to update k; None on a fall, a diverging solve or a finished distance."""
@@ -240,6 +255,7 @@ class SectionMap:
                     (1 - f) * previous.plant + f * snap.plant,
                     (1 - f) * previous.torques + f * snap.torques,
                     (1 - f) * previous.controller + f * snap.controller,
+                    (1 - f) * previous.command + f * snap.command,
                 )
                 # the slots no update changes mid-stance, copied rather than rounded by the blend
                 for slot in (ctl.STANCE_RIGHT, ctl.STEP_COUNT, ctl.STEP_START):

@@ -282,6 +282,45 @@ def test_a_restart_from_an_update_continues_the_walk_exactly(biped_map):
     assert restarted.time_s == pytest.approx(continued.time_s - snap.time_s, abs=1e-12)
 
 
+@pytest.fixture(scope="module")
+def plant_motor_map():
+    """The paper's walker under the plant's hip motor, whose gains and bounds live in the plant's model."""
+    from drake_biped.resources import load_gait
+    from drake_biped.step_map import SectionMap
+
+    section_map = SectionMap(load_gait("paper").override({"gait.motor_solve": "plant"}))
+    z0, template = section_map.start(6)
+    return section_map, z0, template
+
+
+@pytest.mark.slow
+def test_under_the_plant_motor_a_restart_continues_the_walk_exactly_and_no_evaluation_leaks_into_the_next(
+        plant_motor_map):
+    """The plant's hip motors take their gains and bounds from the plant's model and their command from the
+    controller's motor_command group: a restart sets both from the snapshot, so that a restart from an update
+    is the walk that continued, to the bit, and the map at a point is the same on a fresh map, right after
+    start(), and after evaluations that ended with the legs' roles swapped."""
+    from drake_biped import control_kernel as ctl
+    from drake_biped.step_map import SectionMap, Snapshot
+
+    section_map, z0, template = plant_motor_map
+    first = section_map.step(z0, template)
+    assert np.array_equal(section_map.step(z0, template), first)
+    assert np.array_equal(SectionMap(section_map.config).step(z0, template), first)
+    k = int(round(section_map._simulator.get_context().get_time() / section_map._dt)) + 1
+    snap = section_map._advance(k)
+    target = int(snap.controller[ctl.STEP_COUNT]) + 1
+    continued = section_map._to_section(target, k, 3.0)  # through a touchdown: the hips swap roles
+    c = snap.controller.copy()
+    c[ctl.STEP_START] -= snap.time_s
+    c[ctl.STATE_TIME] -= snap.time_s
+    section_map._restore(Snapshot(0.0, snap.plant, snap.torques, c, snap.command))
+    section_map._simulator.Initialize()
+    restarted = section_map._to_section(target, 0, 3.0)
+    assert np.array_equal(restarted.plant, continued.plant)
+    assert restarted.time_s == pytest.approx(continued.time_s - snap.time_s, abs=1e-12)
+
+
 @pytest.mark.slow
 def test_the_held_slots_do_not_change_the_map(biped_map):
     from drake_biped import control_kernel as ctl
