@@ -343,7 +343,8 @@ def test_converged_objective_scores_the_spread_and_the_chatter_at_the_walks_own_
     """Fake walks: while a robust check fails, the robust score - 2; once all hold, -(s + c + m) / 3 with s the
     step period's sd over 1 ms less 1, c the swing hip's sign changes a second over 20 less 1 and m the half step's
     C_mt change over 0.5 % less 1, each capped at 1: 0.5 ms, 10 a second and 0.2 % score 0; 2 ms, 30 a second and
-    0.75 % -(1 + 0.5 + 0.5) / 3."""
+    0.75 % -(1 + 0.5 + 0.5) / 3. The spread is the larger of the walk's at its step and at half of it: regular at
+    its step, 1.5 ms at half of it (a period-doubled orbit there) scores -0.5 / 3."""
     import types
 
     from drake_biped import episode
@@ -357,17 +358,19 @@ def test_converged_objective_scores_the_spread_and_the_chatter_at_the_walks_own_
             "actuator_names": np.array([f"{leg}_{j}_motor" for leg in ("left", "right") for j in ("hip", "knee", "ankle")])})
 
     config = fast_config(sim=SimulationParams(distance_m=100.0))
-    for robust, spread, changes, moved, expected in ((0.0, 5e-4, 10.0, 0.002, 0.0),
-                                                     (0.0, 2e-3, 30.0, -0.0075, -2.0 / 3.0),
-                                                     (-0.3, 5e-4, 10.0, 0.002, -2.3)):
+    for robust, spread, half, changes, moved, expected in ((0.0, 5e-4, 4e-4, 10.0, 0.002, 0.0),
+                                                           (0.0, 2e-3, 5e-4, 30.0, -0.0075, -2.0 / 3.0),
+                                                           (0.0, 5e-4, 1.5e-3, 10.0, 0.002, -0.5 / 3.0),
+                                                           (-0.3, 5e-4, 4e-4, 10.0, 0.002, -2.3)):
         base = {"walked": True, "cost_of_transport": 0.2, "distance_m": 100.0, "reward": 5.0,
                 "step_period_std_s": spread}
         monkeypatch.setattr(objectives, "_walk", lambda c, base=base: base)
-        monkeypatch.setattr(objectives, "_robust_score",
-                            lambda c, b, r=robust, m=moved: (r, {"checks": {}, "half_step_cmt_change": m}))
+        checks = {"half_step": {"step_period_std_s": half}}
+        monkeypatch.setattr(objectives, "_robust_score", lambda c, b, r=robust, m=moved, k=checks: (
+            r, {"checks": k, "half_step_cmt_change": m}))
         monkeypatch.setattr(episode, "run_episode", lambda c, record_trajectory=False, n=changes: recorded(n))
         value, detail = objectives.score(config, objective="converged")
-        assert value == pytest.approx(expected, abs=0.01), (robust, spread, changes, moved, detail)
+        assert value == pytest.approx(expected, abs=0.01), (robust, spread, half, changes, moved, detail)
     assert objectives.OBJECTIVES["converged"].maximum == 0.0
 
 

@@ -220,6 +220,17 @@ def test_foreign_records_are_named_not_a_key_error(tmp_path):
     with pytest.raises(ParameterError, match=r"begun with other settings \(objective 'walk' there, 'hold' here; "
                                              r"sigma 0.1 there, 0.3 here\)"):
         gait_search._check_log(gait_search._read_log(log), other, "es", log)
+    # a search begun under an objective whose scoring has changed since: refused, naming it
+    same = gait_search.GaitSearchSettings(config=FAST, objective="walk", sigma=0.1, seed=0)
+    first = {"generation": 0, "parent": {}, "parent_score": 0.1, "objective": "walk", "sigma": 0.1,
+             "mutations": same.mutations, "seed": 0, "policy_draws": same.policy_draws, "method": "es"}
+    for about, refused in ((gait_search.OBJECTIVES["walk"].about, False), (None, False), ("scored otherwise", True)):
+        log.write_text(json.dumps({**first, **({} if about is None else {"objective_about": about})}) + "\n")
+        if refused:
+            with pytest.raises(ParameterError, match=r"the objective 'walk' scores otherwise since it began"):
+                gait_search._check_log(gait_search._read_log(log), same, "es", log)
+        else:
+            gait_search._check_log(gait_search._read_log(log), same, "es", log)
     (tmp_path / "time_step_study.json").write_text(json.dumps({"baseline": {}, "windows": []}))
     with pytest.raises(ParameterError, match=r"not a time-step study \(no 'steps'\)"):
         time_step.replot(tmp_path)

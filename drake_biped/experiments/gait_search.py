@@ -210,7 +210,8 @@ def _score_start(c, settings: GaitSearchSettings, start: EpisodeConfig, windows,
                              pure=False).result()
     _append(log, {"generation": 0, "parent": start.to_dict(), "parent_score": value, "detail": detail,
                   "seed": settings.seed, "sigma": settings.sigma, "mutations": settings.mutations,
-                  "objective": settings.objective, "policy_draws": settings.policy_draws, **extra, "versions": versions()})
+                  "objective": settings.objective, "objective_about": OBJECTIVES[settings.objective].about,
+                  "policy_draws": settings.policy_draws, **extra, "versions": versions()})
     return value
 
 
@@ -381,6 +382,9 @@ def _check_log(records: list[dict], settings: GaitSearchSettings, method: str, p
         recorded["mutations"] = "servo"
     differs = [f"{k} {recorded[k]!r} there, {wanted[k]!r} here" for k in wanted
                if recorded[k] is not None and recorded[k] != wanted[k]]
+    about = first.get("objective_about")  # what the objective scored when the search began (absent before kept)
+    if not differs and about is not None and about != OBJECTIVES[settings.objective].about:
+        differs.append(f"the objective {settings.objective!r} scores otherwise since it began")
     if differs:
         raise ParameterError(f"{path} is a search begun with other settings ({'; '.join(differs)}): rerun it with "
                              "its own settings to resume, or give another --out")

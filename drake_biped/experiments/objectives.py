@@ -160,7 +160,10 @@ def _converged_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
                         record_trajectory=True)
     if short.fell or short.duration_s <= CONVERGED_AFTER_S + 1.0:
         return -2.0, detail
-    spread = base["step_period_std_s"]
+    # the steps' spread at the walk's step and at half of it: a walk regular at its step only (a period-doubled
+    # orbit at half the step, the touchdowns' grid phase) is not converged
+    half = detail["checks"].get("half_step", {}).get("step_period_std_s")
+    spread = max(base["step_period_std_s"], half if half is not None else math.inf)
     changes = swing_hip_sign_changes_per_s(short.trajectory, CONVERGED_AFTER_S)
     moved = abs(detail["half_step_cmt_change"])
 
@@ -169,7 +172,9 @@ def _converged_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
 
     value = -(excess(spread, CONVERGED_STEP_SD_S) + excess(changes, CONVERGED_SIGN_CHANGES)
               + excess(moved, CONVERGED_CMT_CHANGE)) / 3.0
-    detail["converged"] = {"step_period_std_s": spread, "sign_changes_per_s": changes, "half_step_cmt_change": moved}
+    detail["converged"] = {"step_period_std_s": spread, "step_period_std_s_at_step": base["step_period_std_s"],
+                           "step_period_std_s_at_half_step": half, "sign_changes_per_s": changes,
+                           "half_step_cmt_change": moved}
     return value, detail
 
 
@@ -339,7 +344,7 @@ OBJECTIVES: dict[str, Objective] = {
     "expected": Objective(_expected_score, False, "The expected reward's gain alone, over the same draws (one drawn window that saves much cannot carry a gait whose other draws fall)."),
     "nearest": Objective(_nearest_score, False, '-(d / (1 + d) + f) / 3, d the CPG\'s distance from Table III (`distance_from_table_iii`) and f how many of the +-PUSH_FORCE_N pushes (stability\'s, without a window) the gait does not walk through, to find the walker whose CPG is nearest the paper\'s (with the "near_paper" mutations); in (-1, 0], so any walker, however far, beats every fall, and one that survives both pushes beats every one that does not (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push).'),
     "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold.", 0.0),
-    "converged": Objective(_of_base(_converged_score), True, 'The "robust" objective first (while a check fails, its score - 2), then how far the walk is from converged at its own plant step: -(s + c + m) / 3, s the excess of the step period\'s sd (the walk without a window, after the first 10 m) over CONVERGED_STEP_SD_S, c that of the swing hip\'s sign changes per second (a 10 m walk after CONVERGED_AFTER_S) over CONVERGED_SIGN_CHANGES and m that of the half step\'s relative C_mt change over CONVERGED_CMT_CHANGE, each in units of its target and capped at 1; in [-1, 0] once all hold, 0 when all three are met.', 0.0),
+    "converged": Objective(_of_base(_converged_score), True, 'The "robust" objective first (while a check fails, its score - 2), then how far the walk is from converged at its own plant step: -(s + c + m) / 3, s the excess of the step period\'s sd (the walk without a window, after the first 10 m; the larger of the walk\'s at its step and at half of it) over CONVERGED_STEP_SD_S, c that of the swing hip\'s sign changes per second (a 10 m walk after CONVERGED_AFTER_S) over CONVERGED_SIGN_CHANGES and m that of the half step\'s relative C_mt change over CONVERGED_CMT_CHANGE, each in units of its target and capped at 1; in [-1, 0] once all hold, 0 when all three are met.', 0.0),
     "calibrated": Objective(_of_base(_calibrated_score), True, 'The "converged" objective, then how far the walk without a window is from what the paper prints of its walker: (3 v - p - c) / 5, v the "converged" score, p the excess of the long-run step period\'s relative distance from PAPER_STEP_PERIOD_S (the learner\'s start, 0.5 s, is "half of the walking cycle") over CALIBRATION_TOLERANCE and c that of the long-run C_mt\'s from Table V\'s 0.58 without the window, each in units of the tolerance and capped at 1; while a robust check fails, the "converged" score - 1; in [-1, 0] once all robust checks hold, 0 when the converged targets and both of the paper\'s figures are met.', 0.0),
     "halving": Objective(_of_base(_halving_score), True, 'The "robust" objective first (while a check fails, its score - 2), then the largest long-run C_mt saving among windows placed by the walk\'s own step period (HALVING_WINDOWS, fractions of it, walked over the search\'s distance), +0.01 for each window that walks (-0.5 when none saves more or none walks); a walker whose swing hip does less than HALVING_SCREEN_SHARE of the positive work without the window walks no window and scores its share - 1 (below any walker whose windows were walked).'),
     "story": Objective(_of_draws(_story_score), True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
