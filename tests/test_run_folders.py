@@ -227,7 +227,7 @@ def test_foreign_records_are_named_not_a_key_error(tmp_path):
     for about, refused in ((gait_search.OBJECTIVES["walk"].about, False), (None, False), ("scored otherwise", True)):
         log.write_text(json.dumps({**first, **({} if about is None else {"objective_about": about})}) + "\n")
         if refused:
-            with pytest.raises(ParameterError, match=r"the objective 'walk' scores otherwise since it began"):
+            with pytest.raises(ParameterError, match=r"begun when the objective 'walk' scored otherwise: it cannot be resumed"):
                 gait_search._check_log(gait_search._read_log(log), same, "es", log)
         else:
             gait_search._check_log(gait_search._read_log(log), same, "es", log)

@@ -384,7 +384,8 @@ def _check_log(records: list[dict], settings: GaitSearchSettings, method: str, p
                if recorded[k] is not None and recorded[k] != wanted[k]]
     about = first.get("objective_about")  # what the objective scored when the search began (absent before kept)
     if not differs and about is not None and about != OBJECTIVES[settings.objective].about:
-        differs.append(f"the objective {settings.objective!r} scores otherwise since it began")
+        raise ParameterError(f"{path} is a search begun when the objective {settings.objective!r} scored otherwise: "
+                             "it cannot be resumed under today's; give another --out")
     if differs:
         raise ParameterError(f"{path} is a search begun with other settings ({'; '.join(differs)}): rerun it with "
                              "its own settings to resume, or give another --out")
