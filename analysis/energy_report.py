@@ -60,7 +60,7 @@ def energy_walks_section(walk: dict[str, Any], walks: dict[str, Any] | None) -> 
     if walk.get("energy"):
         lines.append(f"| {walks['gait']}, no window (the walk above) | {format_cost(walk['cost_of_transport'], '—')} | "
                      f"{_audit_cells(walk['energy'])} |")
-    for name, w in walks["walks"].items():
+    for w in walks["walks"].values():
         fell = f" (fell at {w['distance_m']:.1f} m)" if w["fell"] else ""
         lines.append(f"| {w['label']}{fell} | {format_cost(w['cost_of_transport'], '—')} | {_audit_cells(w['energy'])} |")
     for name, w in walks["walks"].items():

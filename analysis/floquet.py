@@ -19,6 +19,7 @@ computations on the biped's step map; this module is their mathematics.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -106,8 +107,9 @@ def newton_fixed_point(evaluate: Batch, x0: np.ndarray, epsilon: float | Sequenc
                        tolerance: float = 1e-8, max_iterations: int = 6, max_halvings: int = 4) -> FixedPoint:
     """Solve P(x) = x by Newton's method: J = DP by central differences at each iterate, the step
     (J - I)⁻¹ (x - P(x)) by an LU solve (scipy), halved while it does not reduce the residual. Stops when
-    the residual |P(x) - x| / |x| is below `tolerance`, after `max_iterations`, or when no halving of the
-    step helps (the map's own noise floor); returns the best iterate, converged or not."""
+    the residual |P(x) - x| / |x| is below `tolerance`, after `max_iterations`, when no halving of the
+    step helps (the map's own noise floor), or when a step of the Jacobian's perturbations fails (a fall);
+    returns the best iterate, converged or not."""
     x = np.asarray(x0, dtype=float).reshape(-1)
     dim = len(x)
     (y,) = check_outputs(evaluate([x]), [x], dim)
@@ -115,7 +117,10 @@ def newton_fixed_point(evaluate: Batch, x0: np.ndarray, epsilon: float | Sequenc
     jac = np.full((dim, dim), np.nan)
     it = 0
     while residuals[-1] > tolerance and it < max_iterations:
-        jac = difference_jacobian(evaluate, x, epsilon)
+        try:
+            jac = difference_jacobian(evaluate, x, epsilon)
+        except StepFailed:  # a perturbed step fell: the best iterate so far is the answer
+            break
         step = scipy.linalg.lu_solve(scipy.linalg.lu_factor(jac - np.eye(dim)), x - y)
         accepted = False
         for _ in range(max_halvings + 1):
@@ -294,6 +299,124 @@ def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) ->
         out.append(d)
     return np.array(out)
 
+
+
+# A map computed through a time-stepping contact simulation is smooth only in pieces: a contact that begins
+# or ends one plant step earlier or later moves its image by a jump of its own size, and such pieces can be
+# far narrower than any perturbation the Jacobian needs. Its slope at the scale of a walker's disturbances is
+# then the least-squares fit of an affine map to many random perturbations of that size, the jumps averaging
+# out as noise; the fit's residual is that noise, and resampling the fit (a bootstrap) says how well it fixes
+# the multipliers.
+
+
+@dataclass(frozen=True)
+class Regression:
+    """The least-squares affine fit of a map near x over random perturbations of one size
+    (`regression_jacobian`): P(x + δ) ≈ image + jacobian δ. `noise`: the residuals' root-mean-square length
+    relative to |x| (the jumps and curvature the affine map leaves); `radius`: the spectral radius of the
+    jacobian (the section's trivial multiplier left out where the section's normal was given); `interval`:
+    its bootstrap 5–95 % range; `samples` fitted, `falls` the perturbed steps that failed (left out)."""
+
+    size: float
+    jacobian: np.ndarray
+    image: np.ndarray
+    noise: float
+    radius: float
+    interval: tuple[float, float]
+    samples: int
+    falls: int
+
+    def resolved(self, tolerance: float) -> bool:
+        """Whether the bootstrap fixes the radius to within `tolerance` (relative) either side."""
+        lo, hi = self.interval
+        return self.falls == 0 and max(self.radius - lo, hi - self.radius) <= tolerance * max(self.radius, 1e-300)
+
+
+def _affine_fit(deltas: np.ndarray, images: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    design = np.column_stack([np.ones(len(deltas)), deltas[:, active]])
+    coef = np.linalg.lstsq(design, images, rcond=None)[0]
+    jac = np.zeros((images.shape[1], len(active)))
+    jac[:, active] = coef[1:].T
+    return coef[0], jac
+
+
+def _radius(jacobian: np.ndarray, section_normal: np.ndarray | None) -> float:
+    return multipliers(jacobian, section_normal).nontrivial_radius()
+
+
+def regression_jacobian(evaluate: Batch, x: np.ndarray, scales: Sequence[float], size: float, samples: int,
+                        seed: int = 0, section_normal: np.ndarray | None = None,
+                        resamples: int = 200) -> Regression:
+    """The map's affine fit near `x` from `samples` perturbations δ = size · scales ⊙ g, g standard normal
+    (coordinates with scale 0 are not perturbed, and their columns are 0), evaluated in one batch; a failed
+    step is left out and counted. The radius's interval comes from `resamples` refits on the samples drawn
+    again with replacement (seeded by `seed`, as the perturbations are). StepFailed when fewer samples
+    than the fit's unknowns + 2 remain."""
+    x = np.asarray(x, dtype=float).reshape(-1)
+    dim = len(x)
+    scales = np.broadcast_to(np.asarray(scales, dtype=float), (dim,))
+    if np.any(~np.isfinite(scales)) or np.any(scales < 0) or not np.any(scales > 0):
+        raise ValueError(f"scales must be >= 0, and not all 0: {scales.tolist()}")
+    if not (math.isfinite(size) and size > 0):
+        raise ValueError(f"size must be positive, got {size!r}")
+    active = scales > 0
+    if samples < int(active.sum()) + 3:
+        raise ValueError(f"samples {samples}: need at least the perturbed coordinates + 3 ({int(active.sum()) + 3})")
+    rng = np.random.default_rng(seed)
+    deltas = size * scales * rng.standard_normal((samples, dim))
+    points = [x + d for d in deltas]
+    outputs = evaluate(points)
+    kept = [i for i, y in enumerate(outputs)
+            if y is not None and np.shape(y) == (dim,) and np.all(np.isfinite(y))]
+    if len(kept) < int(active.sum()) + 2:
+        raise StepFailed(f"{samples - len(kept)} of {samples} perturbed steps of size {size:g} failed: too few "
+                         "left to fit")
+    d = deltas[kept]
+    y = np.array([np.asarray(outputs[i], dtype=float) for i in kept])
+    image, jac = _affine_fit(d, y, active)
+    residuals = y - image - d @ jac.T
+    norm = max(float(np.linalg.norm(x)), 1e-300)
+    noise = float(np.sqrt(np.mean(np.sum(residuals ** 2, axis=1)))) / norm
+    radius = _radius(jac, section_normal)
+    boot = np.random.default_rng([seed, 1])
+    radii = []
+    for _ in range(resamples):
+        pick = boot.integers(0, len(kept), len(kept))
+        radii.append(_radius(_affine_fit(d[pick], y[pick], active)[1], section_normal))
+    lo, hi = np.percentile(radii, [5.0, 95.0]) if radii else (radius, radius)
+    return Regression(size=float(size), jacobian=jac, image=image, noise=noise, radius=radius,
+                      interval=(float(lo), float(hi)), samples=len(kept), falls=samples - len(kept))
+
+
+def regression_plateau(rows: Sequence[Regression], tolerance: float = 0.05) -> dict[str, Any]:
+    """Where the regression's multipliers hold: the longest run of consecutive sizes, each resolved by its
+    bootstrap to within `tolerance` and with no fall, whose radii change by at most `tolerance` (relative)
+    from one size to the next. Returns the chosen size (the run's middle, as `converged_epsilon` chooses) and
+    its index, the plateau's bounds and width in decades; None values where no such run of two exists."""
+    order = sorted(range(len(rows)), key=lambda i: rows[i].size)
+    best: list[int] = []
+    run: list[int] = []
+    for i in order:
+        r = rows[i]
+        if not r.resolved(tolerance):
+            run = []
+            continue
+        if run and abs(r.radius - rows[run[-1]].radius) > tolerance * max(r.radius, rows[run[-1]].radius):
+            run = []
+        run = run + [i]
+        if len(run) > len(best):
+            best = run
+    if len(best) < 2:
+        return {"size": None, "index": None, "plateau": None, "decades": 0.0}
+    mid = best[len(best) // 2]
+    lo, hi = rows[best[0]].size, rows[best[-1]].size
+    return {"size": rows[mid].size, "index": mid, "plateau": [lo, hi], "decades": float(np.log10(hi / lo))}
+
+
+def affine_fixed_point(fit: Regression, x: np.ndarray) -> np.ndarray:
+    """The fixed point of the fitted affine map x + δ ↦ image + J δ: x + (I − J)⁻¹ (image − x)."""
+    x = np.asarray(x, dtype=float).reshape(-1)
+    return x + np.linalg.solve(np.eye(len(x)) - fit.jacobian, fit.image - x)
 
 MAX_PERIOD = 8
 

@@ -77,8 +77,34 @@ def markdown(record: dict[str, Any], title: str = "Floquet multipliers of the pe
                   + ", ".join(f"{v:.1e}" for v in record["sampling_phase_drift"])
                   + f" per step: the gait's sensitivity to the phase of the {period_ms:g} ms control update, "
                   "which the map (restarted at each section) does not see."]
+    if record.get("regression") is not None:
+        lines += regression_lines(record["regression"])
     lines.append("")
     return "\n".join(lines)
+
+
+def regression_lines(fit: dict[str, Any]) -> list[str]:
+    """The least-squares fit's section of floquet.md (`floquet_runs.regression`)."""
+    lines = ["", f"**Least-squares Jacobian** ({fit['samples']} random perturbations per size, each coordinate "
+             "by the size times its scale; the fit's residual spread is the map's noise at that size, and a "
+             "bootstrap of the fit gives the radius's 5–95 % range):", "",
+             "| size | spectral radius | 5–95 % | noise | falls |", "|---|---|---|---|---|"]
+    for r in fit["rows"]:
+        span = "—" if r["interval"] is None else f"{r['interval'][0]:.3g}–{r['interval'][1]:.3g}"
+        noise = "—" if r["noise"] is None else f"{r['noise']:.1e}"
+        lines.append(f"| {r['size']:.0e} | {_fmt(r['radius'])} | {span} | {noise} | {r['falls']} |")
+    p = fit["plateau"]
+    if p["plateau"] is not None:
+        lines += ["", f"Sizes that agree: {p['plateau'][0]:.0e}–{p['plateau'][1]:.0e} ({p['decades']:.1f} decades); "
+                  f"at {p['size']:.0e}, the fitted map's fixed point has residual {fit['fixed_point_residual']:.1e} "
+                  f"against the noise {fit['noise']:.1e}, spectral radius **{fit['radius']:.4f}** (5–95 % "
+                  f"{fit['interval'][0]:.4f}–{fit['interval'][1]:.4f})."]
+        for mode in fit["dominant_modes"][:2]:
+            re, im = mode["multiplier"]
+            lines.append(f"- {re:.4f}{im:+.4f}i: " + ", ".join(f"{c['name']} {c['magnitude']:.2f}"
+                                                             for c in mode["components"][:3]))
+    lines += ["", f"The fit's verdict: **{fit['verdict']}**."]
+    return lines
 
 
 def figure(record: dict[str, Any], path: Path) -> None:

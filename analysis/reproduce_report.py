@@ -17,12 +17,12 @@ from pathlib import Path
 from typing import Any
 
 from drake_biped.analysis.cost_of_transport import format_cost
-from drake_biped.analysis.energy_report import energy_section, energy_walks_section
 from drake_biped.analysis.dynamics_report import (
     dynamics_rows,
     dynamics_section,
     floquet_text,
 )
+from drake_biped.analysis.energy_report import energy_section, energy_walks_section
 from drake_biped.analysis.report_figures import quick_summary_figure, summary_figure
 from drake_biped.analysis.report_text import (
     BEYOND,

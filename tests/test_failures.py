@@ -128,6 +128,9 @@ BAD = [  # (argv with {tmp} and {file:NAME}, texts the one line must hold)
     (["walk", "--push", "0", "--out", "{tmp}/w"], ["--push 0", "changes nothing"]),
     (["learn", "--rewalk-distance", "1000000", "--out", "{tmp}/l"], ["--rewalk-distance 1e+06", "distance_m"]),
     (["floquet", "--settle-steps", "1000000000", "--out", "{tmp}/f"], ["--settle-steps 1000000000", "limit of 1,000"]),
+    (["floquet", "--regression-samples", "5", "--out", "{tmp}/f"], ["regression_samples 5", "at least 20"]),
+    (["floquet", "--regression-samples", "40", "--regression-sizes", "0.01", "--out", "{tmp}/f"],
+     ["--regression-sizes", "'0.01'", "at least three"]),
     (["walk", "--max-time", "100000", "--out", "{tmp}/w"], ["--max-time", "GiB of logs"]),
     (["walk", "--push", "20", "--push-duration", "0", "--out", "{tmp}/w"], ["--push-duration", "must be > 0"]),
 ]

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from retired_gaits import STEADY
 from walkers import fast_config
 
@@ -412,3 +414,88 @@ def test_floquet_reports_the_period_the_map_settles_on():
     assert found["multipliers"][0][0] == pytest.approx(0.16, abs=1e-5)
     chaos = orbit_period(settings, logistic(4.0), np.array([0.3, 0.5]), np.array([0.0, 1.0]))
     assert chaos["period"] is None and chaos["spread"] > 0.5
+
+
+def _jumpy_map(values, noise, seed=3, fall_beyond=None):
+    """A linear map with the multipliers `values` about x* = (1, ..., n), plus a bounded sawtooth of
+    amplitude `noise` that rises steeply and jumps back every 1e-6 along a fixed direction (as a contact that
+    begins one plant step earlier or later moves a simulated step's image); None beyond `fall_beyond`."""
+    rng = np.random.default_rng(seed)
+    n = len(values)
+    basis = rng.standard_normal((n, n))
+    jac = basis @ np.diag(values) @ np.linalg.inv(basis)
+    star = np.arange(1.0, n + 1)
+    w, u = rng.standard_normal(n), rng.standard_normal(n)
+
+    def step(x):
+        d = x - star
+        if fall_beyond is not None and np.linalg.norm(d) > fall_beyond:
+            return None
+        saw = 2.0 * ((1e6 * (w @ x)) % 1.0) - 1.0
+        return star + jac @ d + noise * saw * u / np.linalg.norm(u)
+
+    return fq.serial(step), star, jac
+
+
+def test_a_least_squares_fit_finds_the_multipliers_of_a_map_whose_jumps_defeat_central_differences():
+    values = [0.6, -0.45, 0.3, 0.15, 0.05]
+    evaluate, star, jac = _jumpy_map(values, noise=1e-3)
+    x0 = star + 0.02
+    # central differences see the steep pieces, or the jumps' size over epsilon
+    for epsilon in (1e-8, 1e-6, 1e-5):
+        assert fq.spectral_radius(fq.difference_jacobian(evaluate, x0, epsilon)) > 20
+    rows = [fq.regression_jacobian(evaluate, x0, np.ones(5), size, 400, seed=k)
+            for k, size in enumerate((1e-4, 1e-2, 3e-2, 1e-1))]
+    # far below the jumps' size the fit is noise, and its bootstrap says so; above it, the multipliers
+    assert not rows[0].resolved(0.05)
+    for r in rows[1:]:
+        assert r.resolved(0.05) and abs(r.radius - 0.6) < 0.03 and r.interval[0] < 0.6 < r.interval[1] + 0.01
+        assert abs(r.noise * np.linalg.norm(x0) - 1e-3 / 3 ** 0.5) < 1e-4  # the sawtooth's spread, η/√3
+    plateau = fq.regression_plateau(rows, 0.05)
+    assert plateau["plateau"] == [1e-2, 1e-1] and plateau["size"] == 3e-2 and abs(plateau["decades"] - 1) < 1e-12
+    # the fitted map's fixed point is the map's, to within the jumps
+    x_star = fq.affine_fixed_point(rows[plateau["index"]], x0)
+    assert np.linalg.norm(x_star - star) < 3e-3 < np.linalg.norm(x0 - star)
+
+
+def test_perturbations_that_fall_are_left_out_counted_and_keep_their_size_off_the_plateau():
+    evaluate, star, _ = _jumpy_map([0.7, 0.2, -0.1], noise=1e-4, fall_beyond=0.05)
+    rows = [fq.regression_jacobian(evaluate, star, np.ones(3), size, 60, seed=k)
+            for k, size in enumerate((3e-3, 1e-2, 3e-2))]
+    assert [r.falls > 0 for r in rows] == [False, False, True]
+    assert rows[2].samples + rows[2].falls == 60
+    assert fq.regression_plateau(rows, 0.05)["plateau"] == [3e-3, 1e-2]
+    with pytest.raises(fq.StepFailed, match="too few"):
+        fq.regression_jacobian(evaluate, star, np.ones(3), 1.0, 60)
+    with pytest.raises(ValueError, match="samples"):
+        fq.regression_jacobian(evaluate, star, np.ones(3), 1e-2, 4)
+
+
+def test_newton_stops_at_its_best_iterate_when_a_perturbed_step_falls():
+    jac = np.array([[0.5, 0.1], [0.0, 0.2]])
+    star = np.array([1.0, 0.5])
+
+    def step(x):  # falls wherever the second coordinate is below 0.4
+        return None if x[1] < 0.4 else star + jac @ (x - star)
+
+    start = np.array([1.2, 0.4])
+    fixed = fq.newton_fixed_point(fq.serial(step), start, 1e-3)
+    assert not fixed.converged and np.array_equal(fixed.state, start) and len(fixed.residuals) == 1
+    ok = fq.newton_fixed_point(fq.serial(step), np.array([1.2, 0.6]), 1e-3, tolerance=1e-12)
+    assert ok.converged and np.allclose(ok.state, star)
+
+
+@given(samples=st.integers(-5, 19), sizes=st.lists(st.floats(-1.0, 1.0) | st.just(math.nan), min_size=0, max_size=5))
+@settings(max_examples=25, deadline=None, database=None)
+def test_the_regressions_settings_are_refused_by_name(samples, sizes):
+    from drake_biped.common.floquet_runs import FloquetSettings
+    from drake_biped.params import ParameterError
+
+    if samples != 0:
+        with pytest.raises(ParameterError, match=f"regression_samples {samples}"):
+            FloquetSettings(regression_samples=samples)
+    if len(sizes) < 3 or not all(math.isfinite(v) and v > 0 for v in sizes):
+        with pytest.raises(ParameterError, match="regression_sizes"):
+            FloquetSettings(regression_samples=40, regression_sizes=tuple(sizes))
+    else:
+        assert FloquetSettings(regression_samples=40, regression_sizes=tuple(sizes)).regression_sizes == tuple(sizes)

@@ -38,6 +38,9 @@ from drake_biped.versions import versions
 __all__ = ["FloquetSettings", "analyse", "kept_batch", "run"]
 
 DEFAULT_EPSILONS = tuple(float(10.0 ** e) for e in np.arange(-8.0, -2.49, 0.5))
+# The regression's perturbation sizes, relative to each coordinate's scale: from well inside a walker's
+# step-to-step spread to where its perturbed steps begin to fall.
+DEFAULT_REGRESSION_SIZES = (1e-3, 3e-3, 1e-2, 2e-2, 3e-2)
 
 
 # The most step-map evaluations of one kind a Floquet run is given (settling steps, Newton's iterations, the
@@ -67,6 +70,10 @@ class FloquetSettings:
     # k <= 8 with which its iterates repeat to within period_tolerance (relative; `floquet.periodic_orbit`).
     period_transient: int = 60
     period_tolerance: float = 1e-6
+    # The regression's Jacobians (`regression`): `regression_samples` perturbations per size (0: none), each
+    # coordinate by `size` x its scale (`regression_scales`), for each of `regression_sizes`.
+    regression_samples: int = 0
+    regression_sizes: tuple[float, ...] = DEFAULT_REGRESSION_SIZES
 
     def __post_init__(self) -> None:
         if not isinstance(self.settle_steps, int) or self.settle_steps < 1:
@@ -79,6 +86,13 @@ class FloquetSettings:
                 raise ParameterError(f"{name} {value!r}: must be a positive number")
         if not isinstance(self.decay_steps, int) or self.decay_steps < 1:
             raise ParameterError(f"decay_steps {self.decay_steps!r}: must be an integer >= 1")
+        if not isinstance(self.regression_samples, int) or self.regression_samples < 0:
+            raise ParameterError(f"regression_samples {self.regression_samples!r}: must be an integer >= 0")
+        if self.regression_samples and self.regression_samples < 20:
+            raise ParameterError(f"regression_samples {self.regression_samples}: a fit of the 14 section coordinates "
+                                 "needs at least 20")
+        if len(self.regression_sizes) < 3 or any(not (math.isfinite(e) and e > 0) for e in self.regression_sizes):
+            raise ParameterError(f"regression_sizes {self.regression_sizes!r}: need at least three positive sizes")
         for name in ("newton_iterations", "period_transient"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 0:
                 raise ParameterError(f"{name} {getattr(self, name)!r}: must be an integer >= 0")
@@ -87,13 +101,19 @@ class FloquetSettings:
         check_size(f"--epsilons ({len(self.epsilons)} sizes)", len(self.epsilons), MAX_EPSILONS, "Jacobians", None)
         for name in ("newton_iterations", "period_transient", "decay_steps"):
             check_size(f"{name} {getattr(self, name)}", getattr(self, name), MAX_MAP_STEPS, "steps", None)
+        check_size(f"--regression-samples {self.regression_samples}", self.regression_samples, MAX_MAP_STEPS,
+                   "steps", None)
+        check_size(f"--regression-sizes ({len(self.regression_sizes)} sizes)", len(self.regression_sizes),
+                   MAX_EPSILONS, "Jacobians", None)
 
     def to_dict(self) -> dict[str, Any]:
         return {"settle_steps": self.settle_steps, "epsilons": list(self.epsilons),
                 "newton_epsilon": self.newton_epsilon, "newton_tolerance": self.newton_tolerance,
                 "newton_iterations": self.newton_iterations, "plateau_tolerance": self.plateau_tolerance,
                 "decay_steps": self.decay_steps, "decay_size": self.decay_size, "decay_floor": self.decay_floor,
-                "period_transient": self.period_transient, "period_tolerance": self.period_tolerance}
+                "period_transient": self.period_transient, "period_tolerance": self.period_tolerance,
+                **({"regression_samples": self.regression_samples, "regression_sizes": list(self.regression_sizes)}
+                   if self.regression_samples else {})}
 
 
 # Where a run keeps its step map's evaluations as they finish (`kept_batch`), inside its output folder.
@@ -218,6 +238,69 @@ def orbit_period(settings: FloquetSettings, evaluate: fq.Batch, z0: np.ndarray, 
             "spread": float(np.max(np.ptp(orbit.points, axis=0)))}
 
 
+def regression_scales(z: np.ndarray) -> np.ndarray:
+    """Each section coordinate's scale for the regression's perturbations: its own size, and at least a
+    tenth of the coordinates' root-mean-square (so that a coordinate that is 0 on the orbit, as the section's
+    own angle is, is still perturbed)."""
+    z = np.asarray(z, dtype=float)
+    return np.maximum(np.abs(z), 0.1 * float(np.sqrt(np.mean(z ** 2))))
+
+
+def regression(settings: FloquetSettings, evaluate: fq.Batch, z: np.ndarray, normal: np.ndarray,
+               names: list[str]) -> dict[str, Any]:
+    """The multipliers at the scale of the walker's own disturbances (`floquet.regression_jacobian`): an
+    affine fit of the map for each of settings.regression_sizes around Newton's point `z`; the sizes whose
+    bootstraps fix the radius and agree (`floquet.regression_plateau`); at the plateau's size, the fitted
+    map's fixed point, a fit there, and its multipliers. "established" when a plateau exists and the fit's
+    residual at its fixed point, |image − x*| / |x*|, is within the map's evaluation noise there (the fit's
+    residual spread)."""
+    scales = regression_scales(z)
+    samples, tolerance = settings.regression_samples, settings.plateau_tolerance
+    rows, fits = [], []
+    for k, size in enumerate(settings.regression_sizes):
+        try:
+            fit = fq.regression_jacobian(evaluate, z, scales, size, samples, seed=k, section_normal=normal)
+        except fq.StepFailed as exc:
+            rows.append({"size": float(size), "radius": None, "interval": None, "noise": None, "samples": 0,
+                         "falls": samples, "error": str(exc)})
+            continue
+        fits.append(fit)
+        rows.append({"size": fit.size, "radius": fit.radius, "interval": list(fit.interval), "noise": fit.noise,
+                     "samples": fit.samples, "falls": fit.falls})
+    plateau = fq.regression_plateau(fits, tolerance)
+    out: dict[str, Any] = {"samples": samples, "scales": {n: float(v) for n, v in zip(names, scales)},
+                           "rows": rows, "plateau": plateau, "verdict": "not established: no two sizes agree "
+                           f"to {100 * tolerance:g} % with bootstraps that fix them"}
+    if plateau["index"] is None:
+        return out
+    chosen = fits[plateau["index"]]
+    x_star = fq.affine_fixed_point(chosen, z)
+    try:
+        at = fq.regression_jacobian(evaluate, x_star, scales, chosen.size, samples,
+                                    seed=len(settings.regression_sizes), section_normal=normal)
+    except fq.StepFailed as exc:
+        out["verdict"] = f"not established: the fit at the fitted fixed point failed ({exc})"
+        return out
+    residual = float(np.linalg.norm(at.image - x_star) / max(np.linalg.norm(x_star), 1e-300))
+    mult = fq.multipliers(at.jacobian, normal)
+    dominant = [{"multiplier": [float(mult.values[k].real), float(mult.values[k].imag)],
+                 "modulus": float(abs(mult.values[k])),
+                 "components": fq.named_components(mult.vectors[:, k], names)}
+                for k in range(min(4, len(mult.values))) if mult.trivial[k] is None]
+    if residual > at.noise:
+        verdict = f"not established: the fitted fixed point's residual {residual:.1e} is above the noise {at.noise:.1e}"
+    elif not at.resolved(tolerance):
+        verdict = (f"not established: at the fixed point the radius's bootstrap range {at.interval[0]:.3g}–"
+                   f"{at.interval[1]:.3g} is wider than {100 * tolerance:g} %")
+    else:
+        verdict = "stable" if at.radius < 1.0 else "unstable"
+    out.update(fixed_point={n: float(v) for n, v in zip(names, x_star)}, fixed_point_residual=residual,
+               noise=at.noise, radius=at.radius, interval=list(at.interval), falls=at.falls,
+               multipliers=complex_list(mult.values), trivial=mult.trivial, dominant_modes=dominant,
+               jacobian=at.jacobian.tolist(), verdict=verdict)
+    return out
+
+
 def analyse(settings: FloquetSettings, client, keep: Path | None = None) -> dict[str, Any]:
     """The fixed point, the sweep, the multipliers and the cross-checks of `settings.config`'s gait; each step
     map evaluation kept in `keep` as it finishes, and read back from there by a rerun (`kept_batch`)."""
@@ -243,11 +326,13 @@ def analyse(settings: FloquetSettings, client, keep: Path | None = None) -> dict
     floor = fq.newton_floor(settings.newton_tolerance, noise)
     sweep = fq.epsilon_sweep(evaluate, z, settings.epsilons)
     chosen = fq.converged_epsilon(sweep, settings.plateau_tolerance)
-    index = chosen["index"] if chosen["index"] is not None else int(np.argmin(np.abs(
-        np.log10(np.array(settings.epsilons)) - math.log10(settings.newton_epsilon))))
-    jac = sweep[index]["jacobian"]
-    if jac is None:
+    # without a plateau, the sweep's Jacobian nearest Newton's perturbation among those whose steps all walked
+    walked = [i for i, r in enumerate(sweep) if r["jacobian"] is not None]
+    if not walked:
         raise RuntimeError("every perturbation of the sweep made the walker fall: the gait has no orbit to linearise")
+    index = chosen["index"] if chosen["index"] is not None else min(walked, key=lambda i: abs(
+        math.log10(settings.epsilons[i]) - math.log10(settings.newton_epsilon)))
+    jac = sweep[index]["jacobian"]
     mult = fq.multipliers(jac, section_map.section_normal())
     dominant = []
     for k in range(min(4, len(mult.values))):
@@ -289,6 +374,9 @@ def analyse(settings: FloquetSettings, client, keep: Path | None = None) -> dict
     # The sampling phase: the fixed point continued on its own update grid, against the map's restarts.
     phase = norms([b - z for b in base_run]) if base_run else None
 
+    fitted = (regression(settings, evaluate, z, section_map.section_normal(), names)
+              if settings.regression_samples else None)
+
     return {
         "coordinates": names,
         "multipliers": complex_list(mult.values),
@@ -311,6 +399,7 @@ def analyse(settings: FloquetSettings, client, keep: Path | None = None) -> dict
         "sampling_phase_drift": phase,
         "template": tmpl,
         "orbit_period": period,
+        **({"regression": fitted} if fitted is not None else {}),
         "wall_time_s": time.perf_counter() - wall0,
     }
 

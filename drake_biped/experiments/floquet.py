@@ -37,6 +37,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="touchdowns walked from the initiation before the search starts (default 8)")
     p.add_argument("--epsilons", type=positive_list, default=None,
                    help="perturbation sizes of the sweep, comma-separated (default 1e-8 to 3e-3, half decades)")
+    p.add_argument("--regression-samples", type=count, default=0,
+                   help="also fit the map's Jacobian by least squares over this many random perturbations per "
+                        "size (for a map whose contacts make it jump at small perturbations; default 0: no fit)")
+    p.add_argument("--regression-sizes", type=positive_list, default=None,
+                   help="the fit's perturbation sizes, relative to each coordinate's scale, comma-separated "
+                        "(default 1e-3,3e-3,1e-2,2e-2,3e-2)")
     add_cluster_options(p)
     p.add_argument("--out", required=True, type=out_folder, help="output folder (rerun the same command to resume)")
 
@@ -48,8 +54,9 @@ def settings_from_args(args: argparse.Namespace) -> FloquetSettings:
     config = episode_config(args)
     if args.policy is not None or args.t1 is not None or args.t2 is not None:
         config = config.replace(window=TorqueFreeWindow(*chosen_window(args)))
-    return FloquetSettings(config, settle_steps=args.settle_steps,
-                           **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}))
+    return FloquetSettings(config, settle_steps=args.settle_steps, regression_samples=args.regression_samples,
+                           **({"epsilons": tuple(args.epsilons)} if args.epsilons else {}),
+                           **({"regression_sizes": tuple(args.regression_sizes)} if args.regression_sizes else {}))
 
 
 def command(args: argparse.Namespace) -> int:
@@ -62,5 +69,13 @@ def command(args: argparse.Namespace) -> int:
           f"{record['fixed_point_residual']:.1e}, "
           + ("no perturbation converged" if epsilon is None else f"converged at epsilon {epsilon:g}")
           + f": {record_verdict(record)}")
+    fit = record.get("regression")
+    if fit is not None:
+        plateau = fit["plateau"]
+        print("least-squares fit: " + (f"spectral radius {fit['radius']:.4f} (5-95 % {fit['interval'][0]:.4f}-"
+                                       f"{fit['interval'][1]:.4f}), fixed-point residual "
+                                       f"{fit['fixed_point_residual']:.1e}, noise {fit['noise']:.1e}, plateau "
+                                       f"{plateau['decades']:.1f} decades: " if "radius" in fit else "")
+              + fit["verdict"])
     print(f"wrote {args.out}/floquet.json, floquet.md, floquet.png")
     return 0
