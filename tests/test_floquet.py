@@ -353,7 +353,7 @@ def test_floquet_command_writes_its_record(tmp_path):
     params.write_text(json.dumps(load_gait(STEADY).replace(contact=DRAKE_DEFAULT_CONTACT).to_dict()))
     out = tmp_path / "fl"
     assert cli.main(["floquet", "--params", str(params), "--epsilons", "1e-7,1e-6,1e-5", "--workers", "1",
-                     "--out", str(out)]) == 0
+                     "--regression-samples", "30", "--regression-sizes", "1e-7,3e-7,1e-6", "--out", str(out)]) == 0
     record = json.loads((out / "floquet.json").read_text())
     names = record["coordinates"]
     assert len(record["multipliers"]) == len(names) == len(record["fixed_point"])
@@ -364,6 +364,12 @@ def test_floquet_command_writes_its_record(tmp_path):
     rho = [r["spectral_radius"] for r in record["epsilon_sweep"]]
     assert max(rho) - min(rho) <= 0.05 * max(rho)
     assert record["spectral_radius"] == pytest.approx(max(math.hypot(*m) for m in record["multipliers"]))
+    # where the map is smooth, the least-squares fit is the central differences' Jacobian, and establishes it
+    fit = record["regression"]
+    assert [r["size"] for r in fit["rows"]] == [1e-7, 3e-7, 1e-6] and fit["plateau"]["decades"] > 0
+    assert fit["verdict"] == "unstable" and fit["fixed_point_residual"] <= fit["noise"]
+    assert fit["radius"] == pytest.approx(record["nontrivial_spectral_radius"], rel=0.05)
+    assert "Least-squares Jacobian" in (out / "floquet.md").read_text()
     # the map iterated follows the linearisation over the checked steps
     ratios = record["decay"]["map_iterated_ratio"]
     assert all(0.8 < r < 1.25 for r in ratios)
