@@ -36,9 +36,12 @@ CONVERGED_CMT_CHANGE = 0.005
 # The "calibrated" objective's targets, what the paper prints of its walker without the window: its step period
 # (the learner starts both times at 0.5 s, "half of the walking cycle": a cycle of the swing hip's control, from
 # one step's start to the next, of 1.0 s) and Table V's C_mt without the torque-free period (0.58, read as the
-# dimensionless C_mt, as Table V's ASIMO 1.60 and human 0.05 are); each met within CALIBRATION_TOLERANCE of it.
+# dimensionless C_mt, as Table V's ASIMO 1.60 and human 0.05 are); each met within CALIBRATION_TOLERANCE of it, and
+# scored by its log-ratio to it beyond that, a factor CALIBRATION_REACH away costing the most: a walker far from the
+# paper's figures (C_mt 0.18 against 0.58) still sees which of two candidates is nearer.
 PAPER_STEP_PERIOD_S = 2.0 * 0.5
 CALIBRATION_TOLERANCE = 0.1
+CALIBRATION_REACH = 4.0
 # The "halving" objective: the windows it walks, as fractions (t1, t2) of the walk's own step period (the hip off
 # from early, middle and late in the swing, to the step's end and on through touchdown), and the swing hip's share
 # of the positive work below which no window is walked (freeing a hip that does less than a quarter of the work
@@ -178,9 +181,12 @@ def _converged_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float
     return value, detail
 
 
-def _excess(value: float, target: float, tolerance: float) -> float:
-    """How far `value` lies outside `target` +- `tolerance` (relative), in units of the tolerance, capped at 1."""
-    return min(1.0, max(0.0, abs(value / target - 1.0) / tolerance - 1.0))
+def _excess(value: float, target: float, tolerance: float = CALIBRATION_TOLERANCE,
+            reach: float = CALIBRATION_REACH) -> float:
+    """How far `value` lies from `target` beyond a factor 1 + `tolerance` either way: |ln(value / target)| less
+    ln(1 + tolerance), in units of ln(`reach`), capped at 1 (0 inside the tolerance, 1 from `reach` times or
+    1 / `reach` times the target on)."""
+    return min(1.0, max(0.0, (abs(math.log(value / target)) - math.log1p(tolerance)) / math.log(reach)))
 
 
 def _calibrated_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[float, dict[str, Any]]:
@@ -192,8 +198,8 @@ def _calibrated_score(config: EpisodeConfig, base: dict[str, Any]) -> tuple[floa
     from drake_biped.paper import TABLE_V
 
     target = TABLE_V["CPG without torque-free period"]
-    p = _excess(period, PAPER_STEP_PERIOD_S, CALIBRATION_TOLERANCE)
-    c = _excess(cost, target, CALIBRATION_TOLERANCE)
+    p = _excess(period, PAPER_STEP_PERIOD_S)
+    c = _excess(cost, target)
     detail["calibration"] = {"step_period_mean_s": period, "long_run_cost_of_transport": cost,
                              "step_period_excess": p, "cost_excess": c, "converged_score": value}
     return (3.0 * value - p - c) / 5.0, detail
@@ -345,7 +351,7 @@ OBJECTIVES: dict[str, Objective] = {
     "nearest": Objective(_nearest_score, False, '-(d / (1 + d) + f) / 3, d the CPG\'s distance from Table III (`distance_from_table_iii`) and f how many of the +-PUSH_FORCE_N pushes (stability\'s, without a window) the gait does not walk through, to find the walker whose CPG is nearest the paper\'s (with the "near_paper" mutations); in (-1, 0], so any walker, however far, beats every fall, and one that survives both pushes beats every one that does not (a walk that reaches the distance by luck, near a cliff in the parameters, falls to a push).'),
     "robust": Objective(_of_base(_robust_score), True, "How far the walk without a window is from holding when the simulation is refined or the start is nudged, scored for fallers too: (mean(f) - 1) - e / (len(ROBUST_CHECKS) + 1), f the fraction of the distance walked by the walk itself and under each of ROBUST_CHECKS (the plant step halved, the initiation speed x 0.95 and x 1.05, the +-PUSH_FORCE_N pushes), e the excess of the half step's relative C_mt change over ROBUST_CMT_CHANGE, in units of it, capped at 1 (1 when the half step falls); in [-7/6, 0], 0 once all hold.", 0.0),
     "converged": Objective(_of_base(_converged_score), True, 'The "robust" objective first (while a check fails, its score - 2), then how far the walk is from converged at its own plant step: -(s + c + m) / 3, s the excess of the step period\'s sd (the walk without a window, after the first 10 m; the larger of the walk\'s at its step and at half of it) over CONVERGED_STEP_SD_S, c that of the swing hip\'s sign changes per second (a 10 m walk after CONVERGED_AFTER_S) over CONVERGED_SIGN_CHANGES and m that of the half step\'s relative C_mt change over CONVERGED_CMT_CHANGE, each in units of its target and capped at 1; in [-1, 0] once all hold, 0 when all three are met.', 0.0),
-    "calibrated": Objective(_of_base(_calibrated_score), True, 'The "converged" objective, then how far the walk without a window is from what the paper prints of its walker: (3 v - p - c) / 5, v the "converged" score, p the excess of the long-run step period\'s relative distance from PAPER_STEP_PERIOD_S (the learner\'s start, 0.5 s, is "half of the walking cycle") over CALIBRATION_TOLERANCE and c that of the long-run C_mt\'s from Table V\'s 0.58 without the window, each in units of the tolerance and capped at 1; while a robust check fails, the "converged" score - 1; in [-1, 0] once all robust checks hold, 0 when the converged targets and both of the paper\'s figures are met.', 0.0),
+    "calibrated": Objective(_of_base(_calibrated_score), True, 'The "converged" objective, then how far the walk without a window is from what the paper prints of its walker: (3 v - p - c) / 5, v the "converged" score, p how far the long-run step period lies from PAPER_STEP_PERIOD_S (the learner\'s start, 0.5 s, is "half of the walking cycle") and c how far the long-run C_mt lies from Table V\'s 0.58 without the window, each as its log-ratio beyond ln(1 + CALIBRATION_TOLERANCE), in units of ln(CALIBRATION_REACH), capped at 1; while a robust check fails, the "converged" score - 1; in [-1, 0] once all robust checks hold, 0 when the converged targets and both of the paper\'s figures are met.', 0.0),
     "halving": Objective(_of_base(_halving_score), True, 'The "robust" objective first (while a check fails, its score - 2), then the largest long-run C_mt saving among windows placed by the walk\'s own step period (HALVING_WINDOWS, fractions of it, walked over the search\'s distance), +0.01 for each window that walks (-0.5 when none saves more or none walks); a walker whose swing hip does less than HALVING_SCREEN_SHARE of the positive work without the window walks no window and scores its share - 1 (below any walker whose windows were walked).'),
     "story": Objective(_of_draws(_story_score), True, 'The "robust" objective first, then what the paper\'s learner would find, judged where it holds: while a robust check fails, the "robust" score - 2 (below every walker that holds); once all hold, the "policy" objective with every draw\'s reward gain taken as the smaller of its gains at the step and at half the step (each against no window at that step), the best draw\'s gain as the smallest of that and its gains from the initiation speed x 0.95 and x 1.05 (against no window from the same speed), minus 0.01 d / (1 + d), d the CPG\'s distance from Table III (a tie-breaker towards the paper); from -1.01 up.'),
     "hold": Objective(_of_base(_hold_score), True, 'The "robust" objective first, then whether every window the paper\'s learner may end on holds: the hip off from t1 until the swing foot lands (HOLD_WINDOWS: t1 across the end of the step; the learned windows\' t2 lie past the step\'s end, so the saving is a curve in t1), each walked as it is, at half the plant step and from 0.95 and 1.05 x the initiation speed, against no window under the same change. A window whose t1 lies past the powered step\'s end acts only when a step runs long, and once it acts the step runs long: two gaits, chosen by the walk\'s details, that save much in one walk and little in the next. The learner\'s reach is every window whose best reward gain over the four walks is within HOLD_PLATEAU of the best window\'s (GARB\'s reward is flat there, and a walk that falls into the long step pays it more), every window in HOLD_BAND (where the means of GARB with the paper\'s settings ended on the gaits it has been run on, whatever their reward\'s peak: 500 episodes from t1 0.5 s stop short of a peak further away), and every window within HOLD_MARGIN_S of one of those in t1 (the trials of one GARB run end that far apart on a flat reward); the score is the smallest C_mt saving over that reach and its four walks (-1 for a fall; >= 0.35 where every window GARB may end on holds), plus 0.1 x the mean over HOLD_WINDOWS of each window\'s smallest reward gain (a wider slope that holds), minus 0.01 d / (1 + d) as in "story".'),
