@@ -28,10 +28,10 @@ from pathlib import Path
 
 import numpy as np
 from paper_motor_clock import parse_with_change
+from touchdown_grid import own_records, pending_steps
 
 from drake_biped.analysis import floquet as fq
 from drake_biped.common.floquet_runs import regression_scales
-from drake_biped.resources import load_gait
 from drake_biped.step_map import SectionMap
 from drake_biped.versions import versions
 
@@ -93,18 +93,6 @@ def row_text(name: str, record: dict) -> list[str]:
     return rows
 
 
-def own_records(out: Path) -> dict[str, dict]:
-    records = {}
-    for path in sorted(out.glob("*.json")):
-        try:
-            record = json.loads(path.read_text())
-        except (OSError, ValueError):
-            continue
-        if isinstance(record, dict) and str(record.get("command", "")).startswith(COMMAND):
-            records[path.stem] = record
-    return records
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, required=True)
@@ -118,13 +106,7 @@ def main() -> None:
         print(f"map_noise.py: --out {args.out} holds {SUMMARY}, which this script did not write; choose another "
               "folder", file=sys.stderr)
         raise SystemExit(2)
-    base = load_gait(args.gait).override(args.override) if args.override else load_gait(args.gait)
-    stem = Path(args.gait).stem + (f"-{args.tag}" if args.tag else "")
-    for h_ms in args.h_ms:
-        path = args.out / f"{stem}-h{h_ms:g}ms.json"
-        if path.exists():
-            continue
-        config = base.override({"sim.time_step_s": h_ms * 1e-3})
+    for h_ms, path, config in pending_steps(args):
         start = time.perf_counter()
         record = {"gait": args.gait, "override": args.override, "time_step_s": h_ms * 1e-3,
                   "map": measure(config, args.sizes, args.samples), "wall_time_s": None,
@@ -136,7 +118,7 @@ def main() -> None:
         record["wall_time_s"] = time.perf_counter() - start
         path.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n")
         print("\n".join(row_text(path.stem, record)), flush=True)
-    rows = [line for name, record in own_records(args.out).items() for line in row_text(name, record)]
+    rows = [line for name, record in own_records(args.out, COMMAND).items() for line in row_text(name, record)]
     summary.write_text(HEADER + "\n".join(rows) + "\n")
 
 

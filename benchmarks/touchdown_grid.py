@@ -25,6 +25,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +34,7 @@ from paper_motor_clock import parse_with_change
 from drake_biped.episode import run_episode
 from drake_biped.kinematics import leg_points
 from drake_biped.model import joint_index
-from drake_biped.params import walked_the_distance
+from drake_biped.params import EpisodeConfig, walked_the_distance
 from drake_biped.resources import load_gait
 from drake_biped.versions import versions
 
@@ -168,15 +169,16 @@ TABLE_HEADER = ("| walk | step period sd | variance the grid phase explains | ra
 COMMAND = "python benchmarks/touchdown_grid.py"
 
 
-def own_records(out: Path) -> dict:
-    """The records this script wrote in `out` (by their command), by name; any other JSON file is left alone."""
+def own_records(out: Path, command: str = COMMAND) -> dict:
+    """The records a script wrote in `out` (by their `command`: this one's by default), by name; any other JSON
+    file is left alone."""
     records = {}
     for path in sorted(out.glob("*.json")):
         try:
             record = json.loads(path.read_text())
         except (OSError, ValueError):
             continue
-        if isinstance(record, dict) and str(record.get("command", "")).startswith(COMMAND):
+        if isinstance(record, dict) and str(record.get("command", "")).startswith(command):
             records[path.stem] = record
     return records
 
@@ -187,6 +189,17 @@ def foreign_summary(out: Path) -> Path | None:
     table, figure = out / "touchdown_grid.md", out / "touchdown_grid.png"
     ours = table.is_file() and table.read_text(errors="replace").startswith(TABLE_HEADER)
     return next((path for path in (table, figure) if path.exists() and not ours), None)
+
+
+def pending_steps(args: argparse.Namespace) -> Iterator[tuple[float, Path, EpisodeConfig]]:
+    """For each of args.h_ms (ms) whose record is not yet in args.out: the step, the record's path (the gait's file
+    name, args.tag, the step) and the gait (args.gait with args.override) at that plant step."""
+    base = load_gait(args.gait).override(args.override) if args.override else load_gait(args.gait)
+    stem = Path(args.gait).stem + (f"-{args.tag}" if args.tag else "")
+    for h_ms in args.h_ms:
+        path = args.out / f"{stem}-h{h_ms:g}ms.json"
+        if not path.exists():
+            yield h_ms, path, base.override({"sim.time_step_s": h_ms * 1e-3})
 
 
 def main() -> None:
@@ -201,13 +214,7 @@ def main() -> None:
         print(f"touchdown_grid.py: --out {args.out} holds {foreign.name}, which this script did not write; choose "
               "another folder", file=sys.stderr)
         raise SystemExit(2)
-    base = load_gait(args.gait).override(args.override) if args.override else load_gait(args.gait)
-    stem = Path(args.gait).stem + (f"-{args.tag}" if args.tag else "")
-    for h_ms in args.h_ms:
-        path = args.out / f"{stem}-h{h_ms:g}ms.json"
-        if path.exists():
-            continue
-        config = base.override({"sim.time_step_s": h_ms * 1e-3})
+    for h_ms, path, config in pending_steps(args):
         start = time.perf_counter()
         record = {"gait": args.gait, "override": args.override, "time_step_s": h_ms * 1e-3,
                   "grid": grid_phase_rows(config, args.distance), "contact": contact_rows(config),
