@@ -300,7 +300,6 @@ def predicted_deviations(jacobian: np.ndarray, delta: np.ndarray, steps: int) ->
     return np.array(out)
 
 
-
 # A map computed through a time-stepping contact simulation is smooth only in pieces: a contact that begins
 # or ends one plant step earlier or later moves its image by a jump of its own size, and such pieces can be
 # far narrower than any perturbation the Jacobian needs. Its slope at the scale of a walker's disturbances is
@@ -417,6 +416,7 @@ def affine_fixed_point(fit: Regression, x: np.ndarray) -> np.ndarray:
     """The fixed point of the fitted affine map x + δ ↦ image + J δ: x + (I − J)⁻¹ (image − x)."""
     x = np.asarray(x, dtype=float).reshape(-1)
     return x + np.linalg.solve(np.eye(len(x)) - fit.jacobian, fit.image - x)
+
 
 MAX_PERIOD = 8
 
